@@ -1,0 +1,203 @@
+"""B-spline and NURBS curves.
+
+Evaluation and derivatives follow Piegl & Tiller, The NURBS Book 2e: Alg. A3.1/A3.2
+(non-rational point and derivatives), A4.1/A4.2 (rational point and derivatives from
+the homogeneous ones). Everything is float64 and vectorised over parameters.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import comb
+
+import numpy as np
+
+from ..errors import GeometryError
+from .basis import (
+    basis_function_derivatives,
+    basis_functions,
+    check_parameters,
+    domain_of,
+    find_span,
+    validate_degree,
+    validate_knots,
+)
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
+
+
+def validate_weights(weights, shape: tuple, what: str = "weights") -> np.ndarray:
+    """Finite, strictly positive weights of the given shape, as a read-only float64 copy."""
+    w = np.array(weights, dtype=np.float64)
+    if w.shape != shape:
+        raise GeometryError(f"{what}: expected shape {shape}, got {w.shape}")
+    if not np.all(np.isfinite(w)):
+        raise GeometryError(f"{what} contain a non-finite value ({w[~np.isfinite(w)].flat[0]!r})")
+    if np.any(w <= 0):
+        raise GeometryError(f"{what} must be > 0, got {w[w <= 0].flat[0]!r}")
+    return _readonly(w)
+
+
+def validate_points(points, what: str = "control_points") -> np.ndarray:
+    """Finite float64 copy of a point array (read-only)."""
+    P = np.array(points, dtype=np.float64)
+    if P.size and not np.all(np.isfinite(P)):
+        idx = tuple(int(i) for i in np.argwhere(~np.isfinite(P))[0])
+        raise GeometryError(f"{what}{list(idx)} is not finite ({P[idx]!r})")
+    return _readonly(P)
+
+
+def rational_derivatives(Aders: np.ndarray, wders: np.ndarray) -> np.ndarray:
+    """Derivatives of C = A/w from those of A = wC and w (NURBS Book Alg. A4.2).
+
+    ``Aders``: S + (d+1, dim), ``wders``: S + (d+1,). Returns S + (d+1, dim).
+    """
+    d = Aders.shape[-2] - 1
+    CK = np.empty_like(Aders)
+    w0 = wders[..., 0:1]
+    for k in range(d + 1):
+        v = Aders[..., k, :].copy()
+        for i in range(1, k + 1):
+            v -= comb(k, i) * wders[..., i : i + 1] * CK[..., k - i, :]
+        CK[..., k, :] = v / w0
+    return CK
+
+
+@dataclass(frozen=True, eq=False)
+class BSplineCurve:
+    """A B-spline curve, rational when ``weights`` is given.
+
+    degree: p >= 1.
+    knots: (n+p+2,) non-decreasing; clamped or not.
+    control_points: (n+1, dim) Euclidean points (not pre-multiplied by the weights).
+    weights: (n+1,) positive, or None for a non-rational curve.
+    """
+
+    degree: int
+    knots: np.ndarray
+    control_points: np.ndarray
+    weights: np.ndarray | None = None
+
+    def __post_init__(self):
+        p = validate_degree(self.degree)
+        P = validate_points(self.control_points)
+        if P.ndim != 2 or P.shape[1] < 1:
+            raise GeometryError(f"control_points: expected shape (n+1, dim), got {P.shape}")
+        if P.shape[0] < p + 1:
+            raise GeometryError(
+                f"control_points: degree {p} needs at least {p + 1} control points, got {P.shape[0]}"
+            )
+        U = validate_knots(self.knots, p, P.shape[0])
+        object.__setattr__(self, "degree", p)
+        object.__setattr__(self, "control_points", P)
+        object.__setattr__(self, "knots", U)
+        if self.weights is not None:
+            object.__setattr__(self, "weights", validate_weights(self.weights, (P.shape[0],)))
+
+    # -- properties ---------------------------------------------------------------
+    @property
+    def dim(self) -> int:
+        return self.control_points.shape[1]
+
+    @property
+    def n_control(self) -> int:
+        return self.control_points.shape[0]
+
+    @property
+    def is_rational(self) -> bool:
+        return self.weights is not None
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        return domain_of(self.knots, self.degree)
+
+    @property
+    def homogeneous(self) -> np.ndarray:
+        """Control points in homogeneous form (w*P, w): shape (n+1, dim+1)."""
+        w = np.ones(self.n_control) if self.weights is None else self.weights
+        return np.concatenate([self.control_points * w[:, None], w[:, None]], axis=1)
+
+    @classmethod
+    def from_homogeneous(cls, degree: int, knots, Pw: np.ndarray, rational: bool | None = None):
+        """Build from homogeneous points (w*P, w). ``rational=None`` keeps weights only if not all 1."""
+        Pw = np.asarray(Pw, dtype=np.float64)
+        w = Pw[:, -1]
+        if np.any(w <= 0) or not np.all(np.isfinite(w)):
+            raise GeometryError("homogeneous control points have non-positive or non-finite weights")
+        P = Pw[:, :-1] / w[:, None]
+        if rational is None:
+            rational = not np.all(w == 1.0)
+        return cls(degree, knots, P, w if rational else None)
+
+    def with_control_points(self, control_points, weights="keep") -> "BSplineCurve":
+        """Same degree and knots, new control points (and weights unless kept)."""
+        w = self.weights if isinstance(weights, str) and weights == "keep" else weights
+        return BSplineCurve(self.degree, self.knots, control_points, w)
+
+    def size(self) -> float:
+        """Diagonal of the control polygon's bounding box: the length scale for tolerances."""
+        P = self.control_points
+        return float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
+
+    # -- evaluation ---------------------------------------------------------------
+    def _homogeneous_derivatives(self, u: np.ndarray, order: int) -> np.ndarray:
+        p = self.degree
+        span = find_span(self.knots, p, u)
+        Pw = self.homogeneous if self.is_rational else self.control_points
+        idx = span[..., None] - p + np.arange(p + 1)
+        if order == 0:
+            N = basis_functions(self.knots, p, u, span)
+            return np.einsum("...j,...jd->...d", N, Pw[idx])[..., None, :]
+        ders = basis_function_derivatives(self.knots, p, u, span, order)
+        return np.einsum("...kj,...jd->...kd", ders, Pw[idx])
+
+    def derivatives(self, u, order: int = 1) -> np.ndarray:
+        """C and its derivatives up to ``order`` at ``u``: shape u.shape + (order+1, dim).
+
+        NURBS Book Alg. A3.2, and A4.2 for rational curves.
+        """
+        if order < 0:
+            raise GeometryError(f"derivative order must be >= 0, got {order}")
+        u = check_parameters(u, self.knots, self.degree)
+        H = self._homogeneous_derivatives(u, order)
+        if not self.is_rational:
+            return H
+        return rational_derivatives(H[..., :-1], H[..., -1])
+
+    def evaluate(self, u) -> np.ndarray:
+        """Points C(u): shape u.shape + (dim,) (NURBS Book Alg. A3.1 / A4.1)."""
+        u = check_parameters(u, self.knots, self.degree)
+        H = self._homogeneous_derivatives(u, 0)[..., 0, :]
+        if not self.is_rational:
+            return H
+        return H[..., :-1] / H[..., -1:]
+
+    __call__ = evaluate
+
+    def tangent(self, u) -> np.ndarray:
+        """Unit tangent C'/|C'|."""
+        d = self.derivatives(u, 1)[..., 1, :]
+        return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+    def curvature(self, u) -> np.ndarray:
+        """Curvature at ``u``. Signed (x'y'' - y'x'')/|C'|^3 for planar (dim 2) curves,
+        |C' x C''|/|C'|^3 otherwise."""
+        D = self.derivatives(u, 2)
+        d1, d2 = D[..., 1, :], D[..., 2, :]
+        speed = np.linalg.norm(d1, axis=-1)
+        if self.dim == 2:
+            num = d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]
+        else:
+            d1_3 = np.zeros(d1.shape[:-1] + (3,))
+            d2_3 = np.zeros(d2.shape[:-1] + (3,))
+            d1_3[..., : self.dim] = d1[..., :3]
+            d2_3[..., : self.dim] = d2[..., :3]
+            num = np.linalg.norm(np.cross(d1_3, d2_3), axis=-1)
+        return num / speed**3
+
+    def sample(self, count: int) -> np.ndarray:
+        """``count`` points at parameters uniformly spaced over the domain."""
+        a, b = self.domain
+        return self.evaluate(np.linspace(a, b, count))

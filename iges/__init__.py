@@ -1,0 +1,1 @@
+"""Bpy-free IGES 5.3 writer and reader: entities as plain data records."""
