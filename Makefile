@@ -24,7 +24,8 @@ test-unit: $(STAMP)
 	$(PY) -m pytest tests/unit
 
 bench: $(STAMP)
-	$(PY) bench/run.py
+	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-bench.txt
+	$(PY) bench/run.py $(BENCH)
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache

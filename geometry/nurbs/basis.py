@@ -55,14 +55,16 @@ def validate_knots(knots, degree: int, n_control: int, what: str = "knots") -> n
     a, b = U[p], U[n_control]
     if not b > a:
         raise GeometryError(f"{what}: the parameter domain [U[{p}], U[{n_control}]] = [{a}, {b}] is empty")
-    interior = U[p + 1 : n_control]
-    if interior.size:
-        values, counts = np.unique(interior, return_counts=True)
-        if np.any(counts > p):
-            v = values[np.argmax(counts)]
-            raise GeometryError(
-                f"{what}: interior knot {v!r} has multiplicity {counts.max()}, more than the degree {p}"
-            )
+    values, counts = np.unique(U, return_counts=True)
+    if counts.max() > p + 1:
+        v = values[np.argmax(counts)]
+        raise GeometryError(
+            f"{what}: knot {v!r} has multiplicity {counts.max()}, more than degree + 1 = {p + 1}"
+        )
+    inside = (values > a) & (values < b) & (counts > p)
+    if inside.any():
+        v, c = values[inside][0], counts[inside][0]
+        raise GeometryError(f"{what}: interior knot {v!r} has multiplicity {c}, more than the degree {p}")
     U.flags.writeable = False
     return U
 

@@ -1,14 +1,25 @@
 """B-spline and NURBS tensor-product surfaces.
 
 Evaluation follows Piegl & Tiller, The NURBS Book 2e: Alg. A3.5/A3.6 (non-rational
-point and derivatives) and A4.3/A4.4 (rational). Scattered parameter pairs are
-evaluated in chunks with one gather of the (p+1)(q+1) active control points per pair;
-full parameter grids use the cheaper row-then-column contraction.
+point and derivatives) and A4.3/A4.4 (rational).
+
+Two evaluation paths give the same numbers (the tests check both against scipy):
+
+- few points: per pair, the basis functions of A2.2/A2.3 and one gather of the
+  (p+1)(q+1) active control points;
+- many points (more than a few per patch): each polynomial patch is converted once to
+  its Taylor (power-basis) coefficients about the patch's midpoint, cached on the
+  surface, and every pair costs one gather of that small table plus a batched matmul
+  with the monomials. This is what lets numpy keep up with scipy's compiled
+  ``NdBSpline`` on scattered points (see ``bench/``).
+
+Full parameter grids use the cheaper row-then-column contraction (``evaluate_grid``).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from math import comb
+from functools import cached_property
+from math import comb, factorial
 
 import numpy as np
 
@@ -24,8 +35,45 @@ from .basis import (
 )
 from .curve import BSplineCurve, validate_points, validate_weights
 
-#: Parameter pairs evaluated per chunk: bounds the temporary (chunk, p+1, q+1, dim) gather.
-EVAL_CHUNK = 1 << 15
+#: Parameter pairs evaluated per chunk: bounds the temporary (chunk, p+1, q+1, dim) gather
+#: and keeps it in cache.
+EVAL_CHUNK = 1 << 13
+#: The patch table is used when there are at least this many points per patch...
+TABLE_MIN_POINTS_PER_PATCH = 4
+#: ...and the table is no larger than this many bytes.
+TABLE_MAX_BYTES = 64 << 20
+
+
+def _taylor_matrices(knots: np.ndarray, degree: int, n_control: int):
+    """Per knot span i (p <= i <= n): the span midpoint m_i and the matrix T_i with
+    ``T_i[k, c] = N^(k)_{i-p+c}(m_i) / k!``, so that on span i
+    ``sum_c N_{i-p+c}(u) P_c = sum_k (u - m_i)^k (T_i P)_k`` (Taylor expansion of the
+    basis, exact for polynomials of degree p; derivatives from NURBS Book Alg. A2.3).
+    Empty spans get zero matrices; they are never selected by :func:`find_span`."""
+    spans = np.arange(degree, n_control)
+    lo, hi = knots[spans], knots[spans + 1]
+    mid = 0.5 * (lo + hi)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        T = basis_function_derivatives(knots, degree, mid, spans, degree)
+    T /= np.array([factorial(k) for k in range(degree + 1)])[:, None]
+    T[hi <= lo] = 0.0
+    return mid, T
+
+
+def _monomial_derivatives(t: np.ndarray, degree: int, order: int) -> np.ndarray:
+    """``out[k, n, a] = d^k/dt^k t^a`` at t[n], for k <= order: shape (order+1, N, degree+1)."""
+    powers = np.empty((t.size, degree + 1))
+    powers[:, 0] = 1.0
+    for a in range(1, degree + 1):
+        np.multiply(powers[:, a - 1], t, out=powers[:, a])
+    if order == 0:
+        return powers[None]
+    out = np.zeros((order + 1, t.size, degree + 1))
+    out[0] = powers
+    for k in range(1, order + 1):
+        for a in range(k, degree + 1):
+            out[k, :, a] = (factorial(a) // factorial(a - k)) * powers[:, a - k]
+    return out
 
 
 def rational_surface_derivatives(Aders: np.ndarray, wders: np.ndarray) -> np.ndarray:
@@ -145,8 +193,52 @@ class BSplineSurface:
     def _net(self) -> np.ndarray:
         return self.homogeneous if self.is_rational else self.control_points
 
+    @cached_property
+    def _patch_table(self):
+        """Taylor coefficients of every patch about its midpoint (see module docstring):
+        (span midpoints in u, in v, table of shape (n_spans_u * n_spans_v, (p+1)(q+1), dim'))."""
+        p, q = self.degree_u, self.degree_v
+        net = self._net()
+        nu, nv = self.shape
+        mid_u, Tu = _taylor_matrices(self.knots_u, p, nu)
+        mid_v, Tv = _taylor_matrices(self.knots_v, q, nv)
+        windows = np.lib.stride_tricks.sliding_window_view(net, (p + 1, q + 1), axis=(0, 1))
+        table = np.einsum("iac,jbd,ijecd->ijabe", Tu, Tv, windows, optimize=True)
+        table = np.ascontiguousarray(table.reshape(Tu.shape[0] * Tv.shape[0], (p + 1) * (q + 1), -1))
+        table.flags.writeable = False
+        return mid_u, mid_v, table
+
+    def _use_patch_table(self, n_points: int) -> bool:
+        p, q = self.degree_u, self.degree_v
+        n_patches = (self.shape[0] - p) * (self.shape[1] - q)
+        table_bytes = n_patches * (p + 1) * (q + 1) * (self.dim + 1) * 8
+        return n_points >= TABLE_MIN_POINTS_PER_PATCH * n_patches and table_bytes <= TABLE_MAX_BYTES
+
+    def _table_derivatives(self, u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
+        p, q = self.degree_u, self.degree_v
+        mid_u, mid_v, table = self._patch_table
+        n_spans_v = mid_v.size
+        out = np.zeros((u.size, order + 1, order + 1, table.shape[2]))
+        for s in range(0, u.size, EVAL_CHUNK):
+            uc, vc = u[s : s + EVAL_CHUNK], v[s : s + EVAL_CHUNK]
+            iu = find_span(self.knots_u, p, uc) - p
+            iv = find_span(self.knots_v, q, vc) - q
+            G = np.take(table, iu * n_spans_v + iv, axis=0)  # (n, (p+1)(q+1), dim')
+            Mu = _monomial_derivatives(uc - mid_u[iu], p, order)
+            Mv = _monomial_derivatives(vc - mid_v[iv], q, order)
+            for k in range(order + 1):
+                for l in range(order + 1 - k):
+                    W = (Mu[k][:, :, None] * Mv[l][:, None, :]).reshape(uc.size, 1, -1)
+                    out[s : s + EVAL_CHUNK, k, l] = np.matmul(W, G)[:, 0]
+        return out
+
     def _homogeneous_derivatives(self, u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
         """Derivatives of the homogeneous surface at flat arrays u, v: (N, d+1, d+1, dim')."""
+        if self._use_patch_table(u.size):
+            return self._table_derivatives(u, v, order)
+        return self._gather_derivatives(u, v, order)
+
+    def _gather_derivatives(self, u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
         p, q = self.degree_u, self.degree_v
         net = self._net()
         nv = net.shape[1]
