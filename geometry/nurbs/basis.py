@@ -111,11 +111,13 @@ def check_parameters(u, knots: np.ndarray, degree: int, what: str = "parameter")
 def find_span(knots: np.ndarray, degree: int, u: np.ndarray) -> np.ndarray:
     """Knot span index i with ``U[i] <= u < U[i+1]``, vectorised (NURBS Book Alg. A2.1).
 
-    The end of the domain belongs to the last non-empty span, as in A2.1.
+    The end of the domain belongs to the last non-empty span, as in A2.1; on unclamped
+    vectors whose end knot U[n+1] is repeated below index n+1 that span lies below n.
     """
     n = len(knots) - degree - 2
+    last = np.searchsorted(knots, knots[n + 1], side="left") - 1  # last i with U[i] < U[n+1]
     span = np.searchsorted(knots, u, side="right") - 1
-    return np.clip(span, degree, n)
+    return np.clip(span, degree, last)
 
 
 def basis_functions(knots: np.ndarray, degree: int, u: np.ndarray, span: np.ndarray) -> np.ndarray:

@@ -49,6 +49,19 @@ def test_curve_matches_scipy(degree, clamped):
         assert rel_err(D[:, k], ref(u, nu=k)) < REL, k
 
 
+def test_domain_end_on_a_repeated_unclamped_knot():
+    """The end of the domain belongs to the last non-empty span even when the end knot
+    is repeated inside an unclamped vector (Blender's Bezier mode without endpoint)."""
+    U = [0, 0, 0, 1, 2, 2, 2, 3, 3]  # degree 2, 6 points: domain [0, 2], U[5] = U[4] = 2
+    P = np.random.default_rng(8).normal(size=(6, 2))
+    curve = BSplineCurve(2, U, P)
+    ref = BSpline(np.asarray(U, float), P, 2)
+    u = np.array([0.0, 0.5, 1.0, 1.999999, 2.0])
+    assert np.all(np.isfinite(curve.evaluate(u)))
+    assert rel_err(curve.evaluate(u[:-1]), ref(u[:-1])) < REL
+    assert np.allclose(curve.evaluate(2.0), curve.evaluate(2.0 - 1e-12), atol=1e-9)
+
+
 @pytest.mark.parametrize("degree", [1, 2, 3, 4, 5])
 def test_rational_curve_quotient_rule(degree):
     """C = A/w with A, w evaluated independently by scipy; derivatives by the quotient rule."""
