@@ -1,0 +1,485 @@
+"""Propeller definition files (TOML, lengths in metres), validated once.
+
+Format (every field is checked; messages name the file, the field and the value)::
+
+    name = "DTMB 4119"
+    blades = 3                    # Z
+    diameter = 0.3048             # D, m
+    hub_diameter_ratio = 0.2      # hub diameter / D (the cylindrical part of the hub)
+    hand = "right"                # "right" or "left"
+    # radial_table = "file.csv"   # instead of [radial]: CSV with the [radial] column names
+
+    [section]
+    thickness = "naca66mod"       # "naca66mod", "naca4", "elliptic", "table", or an airfoil .dat
+                                  # path relative to this file
+    meanline = "a=0.8"            # "a=0.8", "a=0.8mod", "parabolic", "naca4", "none", "table",
+                                  # "airfoil" (the mean line of the .dat file)
+    # thickness_x_c = [...]; thickness_t = [...]   (thickness = "table": x/c and T/T0)
+    # meanline_x_c = [...];  meanline_f = [...]    (meanline = "table": x/c and f/f0)
+
+    [hub]                         # spine: nose, cylinder of the hub radius, tail (Hally §10)
+    upstream_length = 0.1067      # m, from the propeller plane z = 0 to the nose tip (upstream)
+    downstream_length = 0.1372    # m, from z = 0 to the tail end (downstream)
+    nose_shape = "ellipse"        # "ellipse", "cone" or "flat"
+    nose_length = 0.0457          # m, axial length of the nose shape (0 for "flat")
+    tail_shape = "ellipse"
+    tail_length = 0.0610
+
+    [radial]                      # arrays of equal length, stations from root to tip (r/R = 1)
+    r_R = [...]                   # r/R, strictly increasing, last = 1
+    c_D = [...]                   # chord / D (> 0; 0 allowed at the tip only)
+    P_D = [...]                   # pitch / D (> 0)
+    skew_deg = [...]              # skew angle of the mid-chord point, degrees, positive = skew back
+    rake_D = [...]                # generator-line rake / D, positive downstream (aft)
+    t_c = [...]                   # maximum thickness / chord (> 0)
+    f_c = [...]                   # maximum camber / chord (towards the suction side)
+
+A CSV radial table has a header line with those column names ('#' lines are comments;
+``t0_c`` and ``f0_c`` are accepted for ``t_c`` and ``f_c``).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import pathlib
+import tempfile
+import tomllib
+from dataclasses import dataclass, field, fields, replace
+
+import numpy as np
+
+from ..errors import DefinitionError
+
+RADIAL_FIELDS = ("r_R", "c_D", "P_D", "skew_deg", "rake_D", "t_c", "f_c")
+CSV_ALIASES = {"t0_c": "t_c", "f0_c": "f_c"}
+HANDS = ("right", "left")
+HUB_SHAPES = ("ellipse", "cone", "flat")
+#: Tolerance on the tip station r/R = 1.
+TIP_TOL = 1e-9
+
+_TOP_KEYS = {"name", "blades", "diameter", "hub_diameter_ratio", "hand", "radial_table", "section", "hub", "radial"}
+_SECTION_KEYS = {"thickness", "meanline", "thickness_x_c", "thickness_t", "meanline_x_c", "meanline_f"}
+_HUB_KEYS = {"upstream_length", "downstream_length", "nose_shape", "nose_length", "tail_shape", "tail_length"}
+
+
+def _fmt(value) -> str:
+    return repr(value) if isinstance(value, str) else f"{value}"
+
+
+def _number(value, field_name: str, path, *, positive=False, minimum=None, integer=False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise DefinitionError(f"expected a number, got {_fmt(value)}", path=path, field=field_name)
+    if integer and (not float(value).is_integer()):
+        raise DefinitionError(f"expected an integer, got {value}", path=path, field=field_name)
+    if not math.isfinite(value):
+        raise DefinitionError(f"value {value} is not finite", path=path, field=field_name)
+    if positive and value <= 0:
+        raise DefinitionError(f"must be positive, got {value}", path=path, field=field_name)
+    if minimum is not None and value < minimum:
+        raise DefinitionError(f"must be at least {minimum}, got {value}", path=path, field=field_name)
+    return int(value) if integer else float(value)
+
+
+def _array(value, field_name: str, path) -> tuple[float, ...]:
+    if not isinstance(value, (list, tuple, np.ndarray)):
+        raise DefinitionError(f"expected an array of numbers, got {_fmt(value)}", path=path, field=field_name)
+    out = []
+    for i, v in enumerate(value):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+            raise DefinitionError(f"entry {i} is {_fmt(v)}, not a number", path=path, field=field_name)
+        if not math.isfinite(float(v)):
+            raise DefinitionError(f"entry {i} is {float(v)} (NaN or infinite)", path=path, field=field_name)
+        out.append(float(v))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class RadialDistribution:
+    """The table of sections: equal-length tuples, root to tip (see the module docstring)."""
+
+    r_R: tuple
+    c_D: tuple
+    P_D: tuple
+    skew_deg: tuple
+    rake_D: tuple
+    t_c: tuple
+    f_c: tuple
+
+    def as_arrays(self) -> dict[str, np.ndarray]:
+        return {name: np.asarray(getattr(self, name), dtype=np.float64) for name in RADIAL_FIELDS}
+
+
+@dataclass(frozen=True)
+class SectionDefinition:
+    thickness: str = "naca66mod"
+    meanline: str = "a=0.8"
+    thickness_x_c: tuple | None = None
+    thickness_t: tuple | None = None
+    meanline_x_c: tuple | None = None
+    meanline_f: tuple | None = None
+
+    def shape(self, base_dir=None, source=None):
+        """The :class:`~bladesmith.geometry.sections.SectionShape` this names (errors name
+        ``source``)."""
+        from ..sections.shape import SectionShape
+
+        return SectionShape.from_spec(
+            self.thickness,
+            self.meanline,
+            base_dir=base_dir,
+            thickness_table=(self.thickness_x_c, self.thickness_t) if self.thickness_x_c is not None else None,
+            meanline_table=(self.meanline_x_c, self.meanline_f) if self.meanline_x_c is not None else None,
+            source=source,
+        )
+
+
+@dataclass(frozen=True)
+class HubDefinition:
+    """Hub spine (Hally 2013 §10): lengths in metres from the propeller plane z = 0."""
+
+    upstream_length: float
+    downstream_length: float
+    nose_shape: str = "ellipse"
+    nose_length: float = 0.0
+    tail_shape: str = "ellipse"
+    tail_length: float = 0.0
+
+    @classmethod
+    def default_for(cls, diameter: float) -> "HubDefinition":
+        """Hub used when a definition has no [hub] table: 0.35 D upstream with a 0.15 D
+        elliptic nose, 0.45 D downstream with a 0.2 D elliptic tail."""
+        return cls(0.35 * diameter, 0.45 * diameter, "ellipse", 0.15 * diameter, "ellipse", 0.2 * diameter)
+
+
+@dataclass(frozen=True)
+class Propeller:
+    """A validated propeller definition (see the module docstring for the format).
+
+    source: the file it was read from (for messages and relative paths), or None.
+    """
+
+    name: str
+    blades: int
+    diameter: float
+    hub_diameter_ratio: float
+    hand: str
+    section: SectionDefinition
+    hub: HubDefinition
+    radial: RadialDistribution
+    source: str | None = field(default=None, compare=False)
+
+    def __post_init__(self):
+        p = self.source
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise DefinitionError(f"expected a non-empty string, got {_fmt(self.name)}", path=p, field="name")
+        object.__setattr__(self, "blades", _number(self.blades, "blades", p, minimum=1, integer=True))
+        object.__setattr__(self, "diameter", _number(self.diameter, "diameter", p, positive=True))
+        h = _number(self.hub_diameter_ratio, "hub_diameter_ratio", p, positive=True)
+        object.__setattr__(self, "hub_diameter_ratio", h)
+        if self.hand not in HANDS:
+            raise DefinitionError(f"expected 'right' or 'left', got {_fmt(self.hand)}", path=p, field="hand")
+        self._validate_radial()
+        tip = self.radial.r_R[-1]
+        if h >= tip:
+            raise DefinitionError(
+                f"hub radius ratio {h} is not below the tip radius ratio r_R = {tip} "
+                f"(hub radius {0.5 * h * self.diameter:g} m >= tip radius {0.5 * tip * self.diameter:g} m)",
+                path=p,
+                field="hub_diameter_ratio",
+            )
+        self._validate_section()
+        self._validate_hub()
+
+    # -- validation -------------------------------------------------------------------
+    def _validate_radial(self):
+        p, rad = self.source, self.radial
+        arrays = {}
+        for name in RADIAL_FIELDS:
+            arrays[name] = _array(getattr(rad, name), f"radial.{name}", p)
+        n = len(arrays["r_R"])
+        if n < 3:
+            raise DefinitionError(f"need at least 3 stations, got {n}", path=p, field="radial.r_R")
+        for name, a in arrays.items():
+            if len(a) != n:
+                raise DefinitionError(f"has {len(a)} entries, r_R has {n}", path=p, field=f"radial.{name}")
+        object.__setattr__(self, "radial", RadialDistribution(**arrays))
+        r = np.asarray(arrays["r_R"])
+        bad = np.nonzero(np.diff(r) <= 0)[0]
+        if bad.size:
+            i = bad[0]
+            raise DefinitionError(
+                f"must increase strictly: entry {i + 1} is {r[i + 1]} after {r[i]}", path=p, field="radial.r_R"
+            )
+        if r[0] <= 0:
+            raise DefinitionError(f"entry 0 is {r[0]}; radii must be positive", path=p, field="radial.r_R")
+        if abs(r[-1] - 1.0) > TIP_TOL:
+            raise DefinitionError(f"the last station must be the tip r_R = 1, got {r[-1]}", path=p, field="radial.r_R")
+        c = np.asarray(arrays["c_D"])
+        for i, v in enumerate(c):
+            if v < 0 or (v == 0 and i != n - 1):
+                what = "negative" if v < 0 else "zero (only the tip chord may be zero)"
+                raise DefinitionError(f"entry {i} (r_R = {r[i]}) is {v}: chord is {what}", path=p, field="radial.c_D")
+        for name in ("P_D", "t_c"):
+            a = np.asarray(arrays[name])
+            bad = np.nonzero(a <= 0)[0]
+            if bad.size:
+                i = bad[0]
+                raise DefinitionError(f"entry {i} (r_R = {r[i]}) is {a[i]}; must be positive", path=p, field=f"radial.{name}")
+        t = np.asarray(arrays["t_c"])
+        if np.any(t >= 1.0):
+            i = int(np.argmax(t >= 1.0))
+            raise DefinitionError(f"entry {i} (r_R = {r[i]}) is {t[i]}; thickness must be below the chord", path=p, field="radial.t_c")
+
+    def _validate_section(self):
+        p, s = self.source, self.section
+        for name in ("thickness", "meanline"):
+            if not isinstance(getattr(s, name), str):
+                raise DefinitionError(f"expected a string, got {_fmt(getattr(s, name))}", path=p, field=f"section.{name}")
+        for name in ("thickness_x_c", "thickness_t", "meanline_x_c", "meanline_f"):
+            v = getattr(s, name)
+            if v is not None:
+                object.__setattr__(s, name, _array(v, f"section.{name}", p))
+        if s.thickness not in ("naca66mod", "naca4", "elliptic", "table"):
+            f = pathlib.Path(s.thickness)
+            if self.base_dir is not None and not f.is_absolute():
+                f = self.base_dir / f
+            if not f.is_file():
+                raise DefinitionError(
+                    f"{s.thickness!r} is neither naca66mod, naca4, elliptic nor table, and the airfoil file "
+                    f"{str(f)!r} does not exist",
+                    path=p,
+                    field="section.thickness",
+                )
+        if s.meanline == "none" and any(v != 0 for v in self.radial.f_c):
+            raise DefinitionError("meanline is 'none' but radial.f_c is not zero", path=p, field="section.meanline")
+        if s.thickness == "table":
+            x, t = s.thickness_x_c, s.thickness_t
+            if x is None or t is None or len(x) != len(t):
+                raise DefinitionError("thickness = 'table' needs thickness_x_c and thickness_t of equal length",
+                                      path=p, field="section.thickness_t")
+            for i, (xi, ti) in enumerate(zip(x, t)):
+                if ti < 0 or (ti == 0 and 0 < xi < 1):
+                    raise DefinitionError(
+                        f"entry {i} (x/c = {xi}) is {ti}: the section would self-intersect",
+                        path=p, field="section.thickness_t",
+                    )
+
+    def _validate_hub(self):
+        p, hub = self.source, self.hub
+        for name in ("upstream_length", "downstream_length"):
+            object.__setattr__(hub, name, _number(getattr(hub, name), f"hub.{name}", p, positive=True))
+        for end in ("nose", "tail"):
+            shape = getattr(hub, f"{end}_shape")
+            if shape not in HUB_SHAPES:
+                raise DefinitionError(f"expected one of {', '.join(HUB_SHAPES)}, got {_fmt(shape)}", path=p, field=f"hub.{end}_shape")
+            length = _number(getattr(hub, f"{end}_length"), f"hub.{end}_length", p, minimum=0.0)
+            object.__setattr__(hub, f"{end}_length", length)
+            if shape != "flat" and length <= 0:
+                raise DefinitionError(f"a {shape} {end} needs a positive length, got {length}", path=p, field=f"hub.{end}_length")
+            total = getattr(hub, "upstream_length" if end == "nose" else "downstream_length")
+            if length >= total:
+                raise DefinitionError(
+                    f"{end} length {length} m must be shorter than the hub's {'upstream' if end == 'nose' else 'downstream'} length {total} m",
+                    path=p, field=f"hub.{end}_length",
+                )
+
+    # -- properties -----------------------------------------------------------------
+    @property
+    def base_dir(self) -> pathlib.Path | None:
+        return pathlib.Path(self.source).parent if self.source else None
+
+    @property
+    def radius(self) -> float:
+        return 0.5 * self.diameter
+
+    @property
+    def hub_radius(self) -> float:
+        return 0.5 * self.hub_diameter_ratio * self.diameter
+
+    def with_values(self, **changes) -> "Propeller":
+        """A copy with top-level fields replaced (validated again); ``radial_<name>=array``,
+        ``section_<name>=...`` and ``hub_<name>=...`` replace one nested field."""
+        nested = {"radial": {}, "section": {}, "hub": {}}
+        top = {}
+        for key, value in changes.items():
+            for prefix in nested:
+                if key.startswith(prefix + "_") and key[len(prefix) + 1 :] in {f.name for f in fields(getattr(self, prefix))}:
+                    nested[prefix][key[len(prefix) + 1 :]] = value
+                    break
+            else:
+                top[key] = value
+        for prefix, vals in nested.items():
+            if vals:
+                top[prefix] = replace(getattr(self, prefix), **vals)
+        return replace(self, **top)
+
+    def build(self):
+        """The float64 model: blade b(ξ, η) and hub (see :class:`~.model.PropellerModel`)."""
+        from .model import PropellerModel
+
+        return PropellerModel.from_definition(self)
+
+    # -- TOML -------------------------------------------------------------------------
+    @classmethod
+    def from_dict(cls, data: dict, source=None) -> "Propeller":
+        p = str(source) if source is not None else None
+        unknown = set(data) - _TOP_KEYS
+        if unknown:
+            raise DefinitionError(f"unknown field(s) {sorted(unknown)}", path=p, field=sorted(unknown)[0])
+        for key in ("name", "blades", "diameter", "hub_diameter_ratio", "hand"):
+            if key not in data:
+                raise DefinitionError("missing", path=p, field=key)
+        sec = data.get("section", {})
+        if not isinstance(sec, dict) or set(sec) - _SECTION_KEYS:
+            raise DefinitionError(f"unknown field(s) {sorted(set(sec) - _SECTION_KEYS)}", path=p, field="section")
+        hub = data.get("hub")
+        if hub is None:
+            diameter = data["diameter"] if isinstance(data["diameter"], (int, float)) else 1.0
+            hub_def = HubDefinition.default_for(float(diameter))
+        else:
+            if not isinstance(hub, dict) or set(hub) - _HUB_KEYS:
+                raise DefinitionError(f"unknown field(s) {sorted(set(hub) - _HUB_KEYS)}", path=p, field="hub")
+            for key in ("upstream_length", "downstream_length"):
+                if key not in hub:
+                    raise DefinitionError("missing", path=p, field=f"hub.{key}")
+            hub_def = HubDefinition(**hub)
+        if "radial_table" in data:
+            if "radial" in data:
+                raise DefinitionError("give either [radial] or radial_table, not both", path=p, field="radial_table")
+            radial = read_radial_csv(data["radial_table"], base_dir=pathlib.Path(p).parent if p else None, source=p)
+        else:
+            rad = data.get("radial")
+            if not isinstance(rad, dict):
+                raise DefinitionError("missing [radial] table (or radial_table = \"file.csv\")", path=p, field="radial")
+            missing = [k for k in RADIAL_FIELDS if k not in rad]
+            if missing:
+                raise DefinitionError("missing", path=p, field=f"radial.{missing[0]}")
+            extra = set(rad) - set(RADIAL_FIELDS)
+            if extra:
+                raise DefinitionError(f"unknown field(s) {sorted(extra)}", path=p, field=f"radial.{sorted(extra)[0]}")
+            radial = RadialDistribution(**{k: rad[k] for k in RADIAL_FIELDS})
+        return cls(
+            name=data["name"],
+            blades=data["blades"],
+            diameter=data["diameter"],
+            hub_diameter_ratio=data["hub_diameter_ratio"],
+            hand=data["hand"],
+            section=SectionDefinition(**sec),
+            hub=hub_def,
+            radial=radial,
+            source=p,
+        )
+
+    @classmethod
+    def from_toml(cls, path) -> "Propeller":
+        """Read and validate a definition file (tomllib)."""
+        path = pathlib.Path(path)
+        try:
+            with open(path, "rb") as fh:
+                data = tomllib.load(fh)
+        except FileNotFoundError:
+            raise DefinitionError("definition file not found", path=str(path)) from None
+        except tomllib.TOMLDecodeError as exc:
+            raise DefinitionError(f"not valid TOML: {exc}", path=str(path)) from None
+        return cls.from_dict(data, source=path.resolve())
+
+    def to_dict(self, relative_to=None) -> dict:
+        """Plain data (the TOML layout). An airfoil-file thickness path is rewritten
+        relative to ``relative_to`` (a folder) when given."""
+        sec = {k: v for k, v in vars(self.section).items() if v is not None}
+        thickness = self.section.thickness
+        if self.base_dir is not None and relative_to is not None and thickness not in ("naca66mod", "naca4", "elliptic", "table"):
+            absolute = (self.base_dir / thickness).resolve()
+            sec["thickness"] = os.path.relpath(absolute, relative_to).replace(os.sep, "/")
+        sec = {k: list(v) if isinstance(v, tuple) else v for k, v in sec.items()}
+        return {
+            "name": self.name,
+            "blades": self.blades,
+            "diameter": self.diameter,
+            "hub_diameter_ratio": self.hub_diameter_ratio,
+            "hand": self.hand,
+            "section": sec,
+            "hub": dict(vars(self.hub)),
+            "radial": {k: list(getattr(self.radial, k)) for k in RADIAL_FIELDS},
+        }
+
+    def to_toml(self, path, header: str = "") -> None:
+        """Write the definition (atomically: temporary file, then os.replace)."""
+        path = pathlib.Path(path)
+        text = dumps_toml(self.to_dict(relative_to=path.resolve().parent), header)
+        fd, tmp = tempfile.mkstemp(prefix=path.name, suffix=".tmp", dir=path.resolve().parent)
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+
+
+def read_radial_csv(name, base_dir=None, source=None) -> RadialDistribution:
+    """A radial table from CSV: a header line with the [radial] column names; '#' lines skipped."""
+    if not isinstance(name, str):
+        raise DefinitionError(f"expected a file name, got {_fmt(name)}", path=source, field="radial_table")
+    path = pathlib.Path(name)
+    if base_dir is not None and not path.is_absolute():
+        path = pathlib.Path(base_dir) / path
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise DefinitionError(f"radial table file {str(path)!r} not found", path=source, field="radial_table") from None
+    lines = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise DefinitionError("empty radial table", path=str(path), field="radial_table")
+    reader = csv.reader(io.StringIO("\n".join(ln for _, ln in lines)))
+    rows = list(reader)
+    header = [CSV_ALIASES.get(h.strip(), h.strip()) for h in rows[0]]
+    missing = [k for k in RADIAL_FIELDS if k not in header]
+    if missing:
+        raise DefinitionError(f"missing column {missing[0]!r} (header {rows[0]})", path=str(path), field=missing[0])
+    cols = {k: [] for k in RADIAL_FIELDS}
+    for (lineno, _), row in zip(lines[1:], rows[1:]):
+        if len(row) != len(header):
+            raise DefinitionError(f"line {lineno}: {len(row)} values, header has {len(header)}", path=str(path))
+        for k in RADIAL_FIELDS:
+            cell = row[header.index(k)].strip()
+            try:
+                v = float(cell)
+            except ValueError:
+                raise DefinitionError(f"line {lineno}: {cell!r} is not a number", path=str(path), field=k) from None
+            if not math.isfinite(v):
+                raise DefinitionError(f"line {lineno}: value {cell} is NaN or infinite", path=str(path), field=k)
+            cols[k].append(v)
+    return RadialDistribution(**{k: tuple(v) for k, v in cols.items()})
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return repr(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def dumps_toml(data: dict, header: str = "") -> str:
+    """TOML text for a dict of scalars, arrays and one level of tables."""
+    out = [("# " + line).rstrip() for line in header.splitlines()] if header else []
+    for k, v in data.items():
+        if not isinstance(v, dict):
+            out.append(f"{k} = {_toml_value(v)}")
+    for k, v in data.items():
+        if isinstance(v, dict):
+            out.append("")
+            out.append(f"[{k}]")
+            for kk, vv in v.items():
+                out.append(f"{kk} = {_toml_value(vv)}")
+    return "\n".join(out) + "\n"

@@ -1,0 +1,191 @@
+"""Airfoil coordinate files (.dat): Selig, reverse Selig and Lednicer, detected automatically.
+
+- Selig (UIUC database): a name line, then x y pairs from the trailing edge over the upper
+  surface to the leading edge and back along the lower surface.
+- Reverse Selig: the same with the lower surface first (e.g. WISDEM/NREL 5-MW files).
+- Lednicer: a name line, a line with the two point counts (``61.  61.``), then the upper
+  surface from leading to trailing edge and the lower surface from leading to trailing edge.
+
+Lines starting with '#' are comments; non-numeric lines before the first coordinate (the
+name, a column header such as ``x_c y_c``) are skipped. A coordinate that is not a number,
+NaN or infinite, or a point repeating the previous one, is refused with the file and line.
+
+The result is normalised to unit chord: the leading edge (the point farthest from the
+trailing-edge midpoint) at the origin and the trailing-edge midpoint at (1, 0).
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DefinitionError
+
+#: Two consecutive points closer than this (in the file's units, relative to the chord)
+#: are reported as duplicates.
+DUPLICATE_TOL = 1e-12
+
+
+@dataclass(frozen=True, eq=False)
+class Airfoil:
+    """A unit-chord airfoil.
+
+    name: the file's name line (or the file stem).
+    upper: (n, 2) suction (upper) side from the leading edge (0, 0) to the trailing edge.
+    lower: (m, 2) pressure (lower) side from the leading edge (0, 0) to the trailing edge.
+    format: "selig", "reverse-selig" or "lednicer" (as detected).
+    path: the file read.
+    """
+
+    name: str
+    upper: np.ndarray
+    lower: np.ndarray
+    format: str
+    path: str = ""
+
+    @property
+    def outline(self) -> np.ndarray:
+        """Selig order: trailing edge, upper surface, leading edge, lower surface: (n+m-1, 2)."""
+        return np.concatenate([self.upper[::-1], self.lower[1:]])
+
+    @property
+    def trailing_edge_thickness(self) -> float:
+        return float(np.linalg.norm(self.upper[-1] - self.lower[-1]))
+
+
+def _parse(path: pathlib.Path):
+    """Numeric rows with their 1-based line numbers, and the name line."""
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        raise DefinitionError("airfoil file not found", path=str(path)) from None
+    except OSError as exc:
+        raise DefinitionError(f"cannot read airfoil file ({exc.strerror})", path=str(path)) from None
+    name = ""
+    rows: list[tuple[int, list[float]]] = []
+    blank_after: set[int] = set()  # indices of rows followed by a blank line (Lednicer)
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = raw.strip()
+        if not line:
+            if rows:
+                blank_after.add(len(rows) - 1)
+            continue
+        if line.startswith("#"):
+            continue
+        tokens = line.replace(",", " ").split()
+        values = []
+        for tok in tokens:
+            try:
+                values.append(float(tok))
+            except ValueError:
+                values = None
+                break
+        if values is None:
+            if rows:
+                raise DefinitionError(f"line {lineno}: expected two numbers 'x y', got {line!r}", path=str(path))
+            name = name or line
+            continue
+        if len(values) != 2:
+            raise DefinitionError(f"line {lineno}: expected two numbers 'x y', got {line!r}", path=str(path))
+        for v in values:
+            if not math.isfinite(v):
+                raise DefinitionError(f"line {lineno}: coordinate is {v} (NaN or infinite): {line!r}", path=str(path))
+        rows.append((lineno, values))
+    if len(rows) < 5:
+        raise DefinitionError(f"only {len(rows)} coordinate lines; an airfoil needs at least 5", path=str(path))
+    return name or path.stem, rows
+
+
+def _check_duplicates(points: np.ndarray, lines: np.ndarray, path: pathlib.Path) -> None:
+    scale = max(float(np.ptp(points[:, 0])), 1e-300)
+    gaps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    bad = np.nonzero(gaps <= DUPLICATE_TOL * scale)[0]
+    if bad.size:
+        i = bad[0]
+        raise DefinitionError(
+            f"line {lines[i + 1]}: point ({points[i + 1, 0]:g}, {points[i + 1, 1]:g}) duplicates the point "
+            f"on line {lines[i]}",
+            path=str(path),
+        )
+
+
+def read_airfoil(path) -> Airfoil:
+    """Read an airfoil .dat file (format auto-detected) and normalise it to unit chord."""
+    path = pathlib.Path(path)
+    name, rows = _parse(path)
+    lines = np.array([r[0] for r in rows])
+    pts = np.array([r[1] for r in rows], dtype=np.float64)
+
+    n_up, n_lo = pts[0]
+    is_lednicer = (
+        n_up >= 2 and n_lo >= 2 and float(n_up).is_integer() and float(n_lo).is_integer()
+        and int(n_up) + int(n_lo) == len(pts) - 1
+    )
+    if is_lednicer:
+        nu = int(n_up)
+        upper, lower = pts[1 : 1 + nu], pts[1 + nu :]
+        lu, ll = lines[1 : 1 + nu], lines[1 + nu :]
+        _check_duplicates(upper, lu, path)
+        _check_duplicates(lower, ll, path)
+        fmt = "lednicer"
+        te_mid = 0.5 * (upper[-1] + lower[-1])
+        # the leading edge is shared by both lists in Lednicer files
+        outline = np.concatenate([upper[::-1], lower[1:] if np.allclose(lower[0], upper[0]) else lower])
+    else:
+        closed = np.linalg.norm(pts[0] - pts[-1]) <= DUPLICATE_TOL * max(np.ptp(pts[:, 0]), 1e-300)
+        body, body_lines = (pts[:-1], lines[:-1]) if closed else (pts, lines)
+        _check_duplicates(body, body_lines, path)
+        te_mid = 0.5 * (pts[0] + pts[-1])
+        outline = pts
+        fmt = "selig"
+    # leading edge: the point farthest from the trailing-edge midpoint
+    dist = np.linalg.norm(outline - te_mid, axis=1)
+    i_le = int(np.argmax(dist))
+    if i_le == 0 or i_le == len(outline) - 1:
+        raise DefinitionError("cannot find a leading edge between the two trailing-edge ends", path=str(path))
+    first, second = outline[: i_le + 1][::-1], outline[i_le:]
+    le = outline[i_le]
+    chord_vec = te_mid - le
+    chord = float(np.hypot(*chord_vec))
+    cos_a, sin_a = chord_vec / chord
+    rot = np.array([[cos_a, sin_a], [-sin_a, cos_a]])
+
+    def normalise(p):
+        return ((p - le) @ rot.T) / chord
+
+    first, second = normalise(first), normalise(second)
+    if is_lednicer:
+        upper, lower = first, second
+    else:
+        # Selig lists the upper side first; a file whose first half lies below the second
+        # is reverse Selig.
+        if np.mean(first[:, 1]) >= np.mean(second[:, 1]):
+            upper, lower = first, second
+        else:
+            upper, lower = second, first
+            fmt = "reverse-selig"
+    return Airfoil(name=name, upper=upper, lower=lower, format=fmt, path=str(path))
+
+
+def _surface_at(surface: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """y of a surface (from the LE at x = 0 to the TE) at chordwise x, interpolated in
+    sqrt(x), which makes the round leading edge regular."""
+    from scipy.interpolate import PchipInterpolator
+
+    xs = np.clip(surface[:, 0], 0.0, None)
+    u = np.sqrt(xs)
+    order = np.argsort(u, kind="stable")
+    u, y = u[order], surface[order, 1]
+    keep = np.concatenate([[True], np.diff(u) > 0])
+    return PchipInterpolator(u[keep], y[keep], extrapolate=True)(np.sqrt(np.clip(x, 0.0, 1.0)))
+
+
+def thickness_and_camber(airfoil: Airfoil, x) -> tuple[np.ndarray, np.ndarray]:
+    """Thickness y_upper - y_lower and mean line (y_upper + y_lower)/2 at chordwise ``x``,
+    both measured normal to the chord line (unit chord)."""
+    x = np.asarray(x, dtype=np.float64)
+    yu = _surface_at(airfoil.upper, x)
+    yl = _surface_at(airfoil.lower, x)
+    return yu - yl, 0.5 * (yu + yl)
