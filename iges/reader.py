@@ -1,0 +1,626 @@
+"""IGES 5.3 reader, fixed 80-column ASCII form (IGES 5.3 §2.2).
+
+Parses a file into the records of :mod:`.records` (references resolved into objects)
+and, through :meth:`IgesModel.to_geometry`, into ``geometry.nurbs`` objects.
+
+Robustness: every malformed input raises :class:`IgesError` with the 1-based line
+number and a reason; nothing else escapes. The work is linear in the file size: each
+count read from the file is checked against the number of parameters actually present
+before anything is allocated, every pointer is range-checked, and reference chains are
+followed with a depth limit and a cycle check, never with unbounded recursion.
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.errors import BladesmithError, IgesError
+from .records import (
+    GLOBAL_FIELDS,
+    BSplineCurve126,
+    BSplineSurface128,
+    CircularArc,
+    CompositeCurve,
+    CurveOnSurface,
+    DirectoryInfo,
+    Entity,
+    GenericEntity,
+    GlobalSection,
+    Line,
+    ParametricSpline,
+    ParametricSplineSurface,
+    SurfaceOfRevolution,
+    TransformationMatrix,
+    TrimmedSurface,
+)
+from .validate import MAX_DEGREE, check_structure
+
+#: Reference chains (144 -> 142 -> 102 -> 126 ...) deeper than this are refused.
+MAX_REFERENCE_DEPTH = 64
+#: Largest file read (bytes); bigger inputs are refused rather than exhausting memory.
+MAX_FILE_BYTES = 1 << 31
+SECTIONS = "SGDPT"
+
+_INT = re.compile(r"[+-]?[0-9]{1,12}")
+_DIGITS = re.compile(r"[0-9]{1,12}")
+_REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
+_HOLLERITH = re.compile(r" *([0-9]{1,9})H")
+
+
+class _Str(str):
+    """A Hollerith string parameter (as opposed to a number or a default)."""
+
+
+# -- the model -----------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class IgesModel:
+    """A parsed file: records in Directory Entry order, the Global section, the Start text."""
+
+    entities: tuple
+    header: GlobalSection
+    start: str = ""
+    path: str | None = None
+
+    @property
+    def roots(self) -> tuple:
+        """Entities no other entity references (the independent ones)."""
+        referenced = set()
+        for e in self.entities:
+            for c in e.references():
+                referenced.add(id(c))
+            if e.transform is not None:
+                referenced.add(id(e.transform))
+        return tuple(e for e in self.entities if id(e) not in referenced)
+
+    def of_type(self, cls) -> list:
+        return [e for e in self.entities if isinstance(e, cls)]
+
+    def to_geometry(self) -> list:
+        """(record, geometry) for every independent curve or surface entity; see
+        :func:`bladesmith.iges.convert.to_geometry`."""
+        from .convert import to_geometry
+
+        out = []
+        for e in self.roots:
+            if isinstance(e, (GenericEntity, TransformationMatrix)):
+                continue
+            try:
+                out.append((e, to_geometry(e)))
+            except IgesError as exc:
+                line = e.directory.line if e.directory is not None else None
+                raise IgesError(str(exc), path=self.path, line=line) from None
+        return out
+
+
+# -- lines and sections -------------------------------------------------------------------------
+class _Source:
+    def __init__(self, path):
+        self.path = None if path is None else os.fspath(path)
+
+    def error(self, message: str, line: int | None):
+        raise IgesError(message, path=self.path, line=line)
+
+
+def _split_lines(data) -> list[str]:
+    if isinstance(data, (bytes, bytearray)):
+        text = bytes(data).decode("latin-1")
+    else:
+        text = data
+    text = text.replace("\r\n", "\n").replace("\r", "\n")
+    lines = text.split("\n")
+    if lines and lines[-1] == "":
+        lines.pop()
+    return lines
+
+
+def _sections(lines: list[str], src: _Source) -> dict:
+    """Lines per section as (line number, text), checking columns, order and sequence numbers."""
+    sec = {k: [] for k in SECTIONS}
+    current = 0
+    for n, line in enumerate(lines, 1):
+        if len(line) != 80:
+            if len(line) >= 73 and line[72] in "CB" and n == 1:
+                src.error("compressed and binary IGES forms are not supported; expected the fixed "
+                          "80-column ASCII form", n)
+            src.error(f"expected 80 columns, got {len(line)}", n)
+        code = line[72]
+        k = SECTIONS.find(code)
+        if k < 0:
+            src.error(f"column 73 must be one of S, G, D, P, T; got {code!r}", n)
+        if k < current:
+            src.error(f"section {code} after section {SECTIONS[current]}", n)
+        current = k
+        seq_text = line[73:80].strip()
+        if not _DIGITS.fullmatch(seq_text) or int(seq_text) != len(sec[code]) + 1:
+            src.error(f"sequence number {line[73:80]!r} in columns 74-80; expected {len(sec[code]) + 1}", n)
+        sec[code].append((n, line))
+    if not lines:
+        src.error("the file is empty", None)
+    if not sec["G"]:
+        src.error("the Global section is missing", len(lines))
+    if len(sec["T"]) != 1:
+        src.error("missing or repeated Terminate section (file truncated?)", len(lines))
+    tn, tline = sec["T"][0]
+    if tn != len(lines):
+        src.error("lines after the Terminate section", tn + 1)
+    for i, code in enumerate("SGDP"):
+        field = tline[8 * i : 8 * i + 8]
+        count = field[1:].strip()
+        if field[0] != code or not _DIGITS.fullmatch(count) or int(count) != len(sec[code]):
+            src.error(f"Terminate section: expected {code}{len(sec[code]):7d} in columns "
+                      f"{8 * i + 1}-{8 * i + 8}, got {field!r}", tn)
+    if len(sec["D"]) % 2:
+        src.error("the Directory Entry section has an odd number of lines", sec["D"][-1][0])
+    return sec
+
+
+# -- parameters ----------------------------------------------------------------------------------
+def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of) -> list:
+    """Parameters of one record up to its record delimiter (IGES 5.3 §2.2.3)."""
+    if "H" not in data:
+        end = data.find(rd)
+        if end < 0:
+            src.error("missing record delimiter", line_of(len(data) - 1))
+        return [t.strip() for t in data[:end].split(pd)]
+    out = []
+    pos, n = 0, len(data)
+    while True:
+        m = _HOLLERITH.match(data, pos)
+        if m:
+            count = int(m.group(1))
+            start = m.end()
+            if count > n - start:
+                src.error("Hollerith string runs past the end of its record", line_of(pos))
+            out.append(_Str(data[start : start + count]))
+            pos = start + count
+            while pos < n and data[pos] == " ":
+                pos += 1
+            if pos >= n:
+                src.error("missing record delimiter", line_of(n - 1))
+            c = data[pos]
+            if c == pd:
+                pos += 1
+                continue
+            if c == rd:
+                return out
+            src.error(f"expected a delimiter after a string, got {c!r}", line_of(pos))
+        a = data.find(pd, pos)
+        b = data.find(rd, pos)
+        if b < 0:
+            src.error("missing record delimiter", line_of(n - 1))
+        if 0 <= a < b:
+            out.append(data[pos:a].strip())
+            pos = a + 1
+        else:
+            out.append(data[pos:b].strip())
+            return out
+
+
+def _parse_int(tok, default=None):
+    if tok == "" and default is not None:
+        return default
+    if isinstance(tok, _Str) or not _INT.fullmatch(tok):
+        return None
+    return int(tok)
+
+
+def _parse_real(tok, default=None):
+    if tok == "" and default is not None:
+        return default
+    if isinstance(tok, _Str) or not _REAL.fullmatch(tok):
+        return None
+    x = float(tok.replace("D", "E").replace("d", "e"))
+    return x if math.isfinite(x) else None
+
+
+class _Params:
+    """A cursor over one entity's parameters with checked reads."""
+
+    def __init__(self, tokens, src: _Source, where: str, line: int, line_of_index, n_entities: int):
+        self.t = tokens
+        self.i = 1  # tokens[0] is the entity type
+        self.src, self.where, self.line = src, where, line
+        self.line_of_index = line_of_index
+        self.n_entities = n_entities
+
+    def error(self, message: str, index: int | None = None):
+        index = self.i if index is None else index
+        self.src.error(f"{self.where}, parameter {index + 1}: {message}", self.line_of_index(index))
+
+    @property
+    def remaining(self) -> int:
+        return len(self.t) - self.i
+
+    def _next(self, what: str, optional: bool):
+        if self.i >= len(self.t):
+            if optional:
+                self.i += 1
+                return ""
+            self.error(f"{what} is missing (record ends early)")
+        tok = self.t[self.i]
+        self.i += 1
+        return tok
+
+    def int(self, what: str, default: int | None = None, lo: int | None = None, hi: int | None = None) -> int:
+        tok = self._next(what, default is not None)
+        v = _parse_int(tok, default)
+        if v is None:
+            self.error(f"{what}: expected an integer, got {str(tok)[:40]!r}", self.i - 1)
+        if (lo is not None and v < lo) or (hi is not None and v > hi):
+            self.error(f"{what} = {v} is outside {lo}..{hi}", self.i - 1)
+        return v
+
+    def count(self, what: str, per_item: int, lo: int = 0, offset: int = 0) -> int:
+        """An integer count c with (c + offset) * per_item parameters still to come."""
+        v = self.int(what, lo=lo)
+        if (v + offset) * per_item > self.remaining:
+            self.error(f"{what} = {v} needs {(v + offset) * per_item} more parameters, but the record "
+                       f"has {self.remaining}", self.i - 1)
+        return v
+
+    def real(self, what: str, default: float | None = None) -> float:
+        tok = self._next(what, default is not None)
+        v = _parse_real(tok, default)
+        if v is None:
+            self.error(f"{what}: expected a finite real number, got {str(tok)[:40]!r}", self.i - 1)
+        return v
+
+    def reals(self, count: int, what: str) -> np.ndarray:
+        if count < 0 or count > self.remaining:
+            self.error(f"{what}: {count} values needed, {max(self.remaining, 0)} present")
+        toks = self.t[self.i : self.i + count]
+        try:
+            if any(isinstance(t, _Str) or t == "" for t in toks):
+                raise ValueError
+            a = np.array([float(t) for t in toks], dtype=np.float64)
+            if not np.all(np.isfinite(a)) or not all(_REAL.fullmatch(t) for t in toks):
+                raise ValueError
+        except ValueError:
+            a = np.empty(count)
+            for k, t in enumerate(toks):
+                v = _parse_real(t, 0.0)
+                if v is None:
+                    self.error(f"{what}[{k}]: expected a finite real number, got {str(t)[:40]!r}", self.i + k)
+                a[k] = v
+        self.i += count
+        return a
+
+    def pointer(self, what: str, optional: bool = False):
+        """A DE pointer (odd sequence number of a first DE line) as an entity index, or None."""
+        tok = self._next(what, optional)
+        v = _parse_int(tok, 0 if optional else None)
+        if v is None:
+            self.error(f"{what}: expected a pointer, got {str(tok)[:40]!r}", self.i - 1)
+        if v == 0:
+            if optional:
+                return None
+            self.error(f"{what}: null pointer", self.i - 1)
+        if v < 0 or v % 2 == 0 or v > 2 * self.n_entities - 1:
+            self.error(f"{what}: dangling pointer {v} (the file has DE lines 1..{2 * self.n_entities})",
+                       self.i - 1)
+        return (v - 1) // 2
+
+    def string(self, what: str) -> str:
+        tok = self._next(what, True)
+        if tok == "":
+            return ""
+        if not isinstance(tok, _Str):
+            self.error(f"{what}: expected a string, got {str(tok)[:40]!r}", self.i - 1)
+        return str(tok)
+
+
+# -- entity builders -------------------------------------------------------------------------------
+def _b110(p: _Params, r, form: int):
+    return dict(start=p.reals(3, "start point"), end=p.reals(3, "end point"), line_form=form)
+
+
+def _b100(p, r, form):
+    z = p.real("ZT", 0.0)
+    c = p.reals(2, "center")
+    s = p.reals(2, "start point")
+    e = p.reals(2, "end point")
+    return dict(center=c, start=s, end=e, z=z)
+
+
+def _b102(p, r, form):
+    n = p.count("N (number of curves)", 1, lo=1)
+    return dict(curves=tuple(r(p.pointer(f"curve {k + 1}"), "constituent") for k in range(n)))
+
+
+def _b112(p, r, form):
+    ctype = p.int("CTYPE", lo=1, hi=6)
+    h = p.int("H (continuity)", default=0)
+    ndim = p.int("NDIM", lo=2, hi=3)
+    n = p.count("N (number of segments)", 13, lo=1)
+    T = p.reals(n + 1, "breakpoints")
+    C = p.reals(12 * n, "coefficients").reshape(n, 3, 4)
+    TP = p.reals(12, "terminal values").reshape(3, 4) if p.remaining >= 12 else np.zeros((3, 4))
+    return dict(spline_type=ctype, continuity=h, ndim=ndim, breakpoints=T, coefficients=C, terminal=TP)
+
+
+def _b114(p, r, form):
+    ctype = p.int("CTYPE", lo=1, hi=6)
+    ptype = p.int("PTYPE", default=0)
+    m = p.count("M (u segments)", 1, lo=1)
+    n = p.count("N (v segments)", 1, lo=1)
+    if (m + 1) + (n + 1) + 48 * m * n > p.remaining:
+        p.error(f"M = {m}, N = {n} need more parameters than the record has")
+    TU = p.reals(m + 1, "u breakpoints")
+    TV = p.reals(n + 1, "v breakpoints")
+    C = np.empty((m, n, 3, 16))
+    for i in range(m):
+        for j in range(n):
+            C[i, j] = p.reals(48, f"patch ({i + 1}, {j + 1})").reshape(3, 16)
+        p.i += 48  # the arbitrary patch (i, N+1)
+    return dict(spline_type=ctype, patch_type=ptype, breakpoints_u=TU, breakpoints_v=TV, coefficients=C)
+
+
+def _b120(p, r, form):
+    axis = r(p.pointer("L (axis)"), "axis")
+    gen = r(p.pointer("C (generatrix)"), "generatrix")
+    return dict(axis=axis, generatrix=gen, start_angle=p.real("SA", 0.0), end_angle=p.real("TA", 2 * math.pi))
+
+
+def _b124(p, r, form):
+    M = p.reals(12, "matrix").reshape(3, 4)
+    return dict(rotation=M[:, :3], translation=M[:, 3], matrix_form=form)
+
+
+def _b126(p, r, form):
+    k = p.int("K (upper index)", lo=0)
+    m = p.int("M (degree)", lo=1, hi=MAX_DEGREE)
+    for name in ("PROP1", "PROP2", "PROP3", "PROP4"):
+        p.int(name, default=0, lo=0, hi=1)
+    if (k + m + 2) + 4 * (k + 1) + 2 > p.remaining:
+        p.error(f"K = {k}, M = {m} need {(k + m + 2) + 4 * (k + 1) + 2} more parameters, "
+                f"the record has {p.remaining}")
+    knots = p.reals(k + m + 2, "knots")
+    w = p.reals(k + 1, "weights")
+    P = p.reals(3 * (k + 1), "control points").reshape(k + 1, 3)
+    v0, v1 = p.real("V(0)"), p.real("V(1)")
+    return dict(degree=m, knots=knots, control_points=P, weights=w, start=v0, end=v1)
+
+
+def _b128(p, r, form):
+    k1 = p.int("K1", lo=0)
+    k2 = p.int("K2", lo=0)
+    m1 = p.int("M1", lo=1, hi=MAX_DEGREE)
+    m2 = p.int("M2", lo=1, hi=MAX_DEGREE)
+    for name in ("PROP1", "PROP2", "PROP3", "PROP4", "PROP5"):
+        p.int(name, default=0, lo=0, hi=1)
+    need = (k1 + m1 + 2) + (k2 + m2 + 2) + 4 * (k1 + 1) * (k2 + 1) + 4
+    if need > p.remaining:
+        p.error(f"K1 = {k1}, K2 = {k2}, M1 = {m1}, M2 = {m2} need {need} more parameters, "
+                f"the record has {p.remaining}")
+    ku = p.reals(k1 + m1 + 2, "u knots")
+    kv = p.reals(k2 + m2 + 2, "v knots")
+    w = p.reals((k1 + 1) * (k2 + 1), "weights").reshape(k2 + 1, k1 + 1).T
+    P = p.reals(3 * (k1 + 1) * (k2 + 1), "control points").reshape(k2 + 1, k1 + 1, 3).transpose(1, 0, 2)
+    ur = (p.real("U(0)"), p.real("U(1)"))
+    vr = (p.real("V(0)"), p.real("V(1)"))
+    return dict(degree_u=m1, degree_v=m2, knots_u=ku, knots_v=kv, control_points=P, weights=w,
+                u_range=ur, v_range=vr)
+
+
+def _b142(p, r, form):
+    crtn = p.int("CRTN", default=0, lo=0, hi=3)
+    s = r(p.pointer("SPTR (surface)"), "surface")
+    b = p.pointer("BPTR (parameter curve)", optional=True)
+    c = p.pointer("CPTR (model curve)", optional=True)
+    pref = p.int("PREF", default=0, lo=0, hi=3)
+    return dict(surface=s, parameter_curve=None if b is None else r(b, "parameter curve"),
+                model_curve=None if c is None else r(c, "model curve"), creation=crtn, preferred=pref)
+
+
+def _b144(p, r, form):
+    s = r(p.pointer("PTS (surface)"), "surface")
+    n1 = p.int("N1", default=0, lo=0, hi=1)
+    n2 = p.count("N2 (number of holes)", 1, lo=0, offset=1)
+    pto = p.pointer("PTO (outer boundary)", optional=True)
+    inner = tuple(r(p.pointer(f"PTI({k + 1})"), "inner boundary") for k in range(n2))
+    outer = None if (pto is None or n1 == 0) else r(pto, "outer boundary")
+    return dict(surface=s, outer=outer, inner=inner)
+
+
+BUILDERS = {
+    100: (CircularArc, _b100), 102: (CompositeCurve, _b102), 110: (Line, _b110),
+    112: (ParametricSpline, _b112), 114: (ParametricSplineSurface, _b114),
+    120: (SurfaceOfRevolution, _b120), 124: (TransformationMatrix, _b124),
+    126: (BSplineCurve126, _b126), 128: (BSplineSurface128, _b128), 142: (CurveOnSurface, _b142),
+    144: (TrimmedSurface, _b144),
+}
+
+
+# -- the parser ---------------------------------------------------------------------------------
+def _field_int(text: str, src: _Source, line: int, what: str) -> int:
+    s = text.strip()
+    if s == "":
+        return 0
+    if not _INT.fullmatch(s):
+        src.error(f"Directory Entry {what}: expected an integer, got {text!r}", line)
+    return int(s)
+
+
+def _parse_global(glines, src: _Source) -> tuple[GlobalSection, str, str]:
+    data = "".join(line[:72] for _, line in glines)
+    first = glines[0][0]
+
+    def line_of(offset):
+        return first + min(max(offset, 0) // 72, len(glines) - 1)
+
+    pos = 0
+    if data.startswith("1H") and len(data) > 3:
+        pd = data[2]
+        pos = 3
+        if data[pos] != pd:
+            src.error("Global section: the parameter delimiter must follow field 1", first)
+        pos += 1
+    elif data.startswith(","):
+        pd, pos = ",", 1
+    else:
+        src.error("Global section: field 1 must be the parameter delimiter (1Hx or defaulted)", first)
+    if data.startswith("1H", pos) and len(data) > pos + 3:
+        rd = data[pos + 2]
+        pos += 3
+        if data[pos] not in (pd, rd):
+            src.error("Global section: a delimiter must follow field 2", line_of(pos))
+        ended = data[pos] == rd
+        pos += 1
+    elif data[pos : pos + 1] == pd:
+        rd, pos, ended = ";", pos + 1, False
+    else:
+        src.error("Global section: field 2 must be the record delimiter (1Hx or defaulted)", line_of(pos))
+    if pd == rd or pd in " 0123456789+-.EDH" or rd in " 0123456789+-.EDH":
+        src.error(f"Global section: unusable delimiters {pd!r} and {rd!r}", first)
+    tokens = [] if ended else _tokenize(data[pos:], pd, rd, src, lambda o: line_of(o + pos))
+    values = {"parameter_delimiter": pd, "record_delimiter": rd}
+    for k, (name, kind) in enumerate(GLOBAL_FIELDS[2:]):
+        tok = tokens[k] if k < len(tokens) else ""
+        where = f"Global section field {k + 3} ({name})"
+        if tok == "":
+            continue  # defaulted
+        if kind == "s":
+            if not isinstance(tok, _Str):
+                src.error(f"{where}: expected a string, got {tok[:40]!r}", line_of(pos))
+            values[name] = str(tok)
+        elif kind == "i":
+            v = _parse_int(tok)
+            if v is None:
+                src.error(f"{where}: expected an integer, got {str(tok)[:40]!r}", line_of(pos))
+            values[name] = v
+        else:
+            v = _parse_real(tok)
+            if v is None:
+                src.error(f"{where}: expected a finite real, got {str(tok)[:40]!r}", line_of(pos))
+            values[name] = v
+    return GlobalSection(**values), pd, rd
+
+
+def parse_iges(data, path=None) -> IgesModel:
+    """Parse IGES text (str or bytes) into an :class:`IgesModel`; IgesError on malformed input."""
+    src = _Source(path)
+    lines = _split_lines(data)
+    sec = _sections(lines, src)
+    start = "\n".join(line[:72].rstrip() for _, line in sec["S"])
+    header, pd, rd = _parse_global(sec["G"], src)
+
+    dlines, plines = sec["D"], sec["P"]
+    n = len(dlines) // 2
+    directory = []
+    for i in range(n):
+        (l1, a), (l2, b) = dlines[2 * i], dlines[2 * i + 1]
+        etype = _field_int(a[0:8], src, l1, "field 1 (entity type)")
+        if _field_int(b[0:8], src, l2, "field 11 (entity type)") != etype:
+            src.error(f"entity type {b[0:8].strip()!r} differs from {a[0:8].strip()!r} on the line before", l2)
+        ptr = _field_int(a[8:16], src, l1, "field 2 (parameter data pointer)")
+        tr = _field_int(a[48:56], src, l1, "field 7 (transformation matrix)")
+        status = a[64:72]
+        if not all(c in " 0123456789" for c in status):  # ASCII digits only
+            src.error(f"Directory Entry field 9 (status number): expected digits, got {status!r}", l1)
+        count = _field_int(b[24:32], src, l2, "field 14 (parameter line count)")
+        form = _field_int(b[32:40], src, l2, "field 15 (form number)")
+        level = _field_int(a[32:40], src, l1, "field 5 (level)")
+        color = _field_int(b[16:24], src, l2, "field 13 (color)")
+        label = b[56:64].strip()
+        subscript = _field_int(b[64:72], src, l2, "field 19 (subscript)")
+        if count < 1 or ptr < 1 or ptr + count - 1 > len(plines):
+            src.error(f"parameter data lines {ptr}..{ptr + count - 1} are outside the Parameter Data "
+                      f"section (1..{len(plines)})", l1)
+        if tr < 0 or tr % 2 == 0 and tr != 0 or tr > 2 * n - 1:
+            src.error(f"Directory Entry field 7: dangling transformation matrix pointer {tr}", l1)
+        directory.append((etype, ptr, count, form, status, level, color, label, subscript, tr, l1))
+
+    built: list = [None] * n
+    visiting = [False] * n
+
+    def build(i: int, depth: int, role: str, referrer_line: int) -> Entity:
+        if built[i] is not None:
+            return built[i]
+        if visiting[i]:
+            src.error(f"recursive reference: entity at DE {2 * i + 1} ({role}) refers back to itself",
+                      referrer_line)
+        if depth > MAX_REFERENCE_DEPTH:
+            src.error(f"references nested deeper than {MAX_REFERENCE_DEPTH}", referrer_line)
+        visiting[i] = True
+        etype, ptr, count, form, status, level, color, label, subscript, tr, l1 = directory[i]
+        first_line = plines[ptr - 1][0]
+        chunks = []
+        seq = 2 * i + 1
+        for k in range(ptr - 1, ptr - 1 + count):
+            ln, text = plines[k]
+            back = text[65:72].strip()
+            if not _DIGITS.fullmatch(back) or int(back) != seq:
+                src.error(f"parameter line points back to DE {text[65:72].strip()!r}; expected {seq}", ln)
+            chunks.append(text[:64])
+        data = "".join(chunks)
+
+        def line_of(offset):
+            return first_line + min(max(offset, 0) // 64, count - 1)
+
+        tokens = _tokenize(data, pd, rd, src, line_of)
+
+        def line_of_index(index):
+            # locate the index-th parameter by counting delimiters (only on error)
+            pos = 0
+            for _ in range(min(index, len(tokens))):
+                nxt = data.find(pd, pos)
+                if nxt < 0:
+                    break
+                pos = nxt + 1
+            return line_of(pos)
+
+        where = f"entity type {etype} at DE {seq}"
+        if not tokens or _parse_int(tokens[0]) != etype:
+            src.error(f"{where}: parameter data start with {str(tokens[0])[:20] if tokens else ''!r}, "
+                      f"not the entity type {etype}", first_line)
+        p = _Params(tokens, src, where, first_line, line_of_index, n)
+
+        def resolve(j, what):
+            return build(j, depth + 1, what, first_line)
+
+        info = DirectoryInfo(sequence=seq, line=l1, parameter_line=first_line, form=form,
+                             status=status, level=level, color=color)
+        common = dict(label=label, subscript=subscript, directory=info)
+        if tr:
+            t = build((tr - 1) // 2, depth + 1, "transformation matrix", l1)
+            if not isinstance(t, TransformationMatrix):
+                src.error(f"{where}: field 7 points to {t.describe()}, not a transformation matrix", l1)
+            common["transform"] = t
+        try:
+            if etype in BUILDERS:
+                cls, fn = BUILDERS[etype]
+                record = cls(**fn(p, resolve, form), **common)
+            else:
+                record = GenericEntity(entity_type=etype, entity_form=form, parameters=tuple(tokens[1:]), **common)
+            check_structure(record)
+        except IgesError as exc:
+            if exc.line is not None:
+                raise
+            src.error(f"{where}: {exc}", first_line)
+        except BladesmithError as exc:
+            src.error(f"{where}: {exc}", first_line)
+        visiting[i] = False
+        built[i] = record
+        return record
+
+    for i in range(n):
+        build(i, 0, "entity", directory[i][10])
+    return IgesModel(entities=tuple(built), header=header, start=start, path=src.path)
+
+
+def read_iges(path) -> IgesModel:
+    """Read an IGES file (IGES 5.3 fixed form) into an :class:`IgesModel`."""
+    p = os.fspath(path)
+    try:
+        size = os.path.getsize(p)
+        if size > MAX_FILE_BYTES:
+            raise IgesError(f"file of {size} bytes exceeds the limit of {MAX_FILE_BYTES}", path=p)
+        with open(p, "rb") as f:
+            data = f.read()
+    except OSError as exc:
+        raise IgesError(f"cannot read the file: {exc}", path=p) from exc
+    return parse_iges(data, path=p)

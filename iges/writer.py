@@ -1,0 +1,517 @@
+"""IGES 5.3 writer, fixed 80-column ASCII form (IGES 5.3 §2.2).
+
+The five sections (IGES 5.3 §2.2.4): Start (S), Global (G), Directory Entry (D, two
+lines per entity), Parameter Data (P, columns 1-64 data, 66-72 the back-pointer to the
+entity's first DE line) and Terminate (T). Columns 73-80 hold the section letter and a
+sequence number counting from 1 in each section.
+
+Everything is validated and serialised in memory before the file is touched; the
+file is then written to a temporary file in the same folder and moved over the target
+with ``os.replace``, so a failed export never leaves a partial file or clobbers the
+previous one (ARCHITECTURE.md, house style 8).
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import math
+import os
+import re
+import tempfile
+from itertools import chain
+
+import numpy as np
+
+from ..geometry.errors import BladesmithError, IgesError
+from .records import (
+    UNIT_NAMES,
+    UNITS,
+    BSplineCurve126,
+    BSplineSurface128,
+    CircularArc,
+    CompositeCurve,
+    CurveOnSurface,
+    Entity,
+    GenericEntity,
+    GlobalSection,
+    GLOBAL_FIELDS,
+    Line,
+    ParametricSpline,
+    ParametricSplineSurface,
+    SurfaceOfRevolution,
+    TransformationMatrix,
+    TrimmedSurface,
+)
+from .validate import curve_flags, surface_flags, validate_entity, validate_loop
+
+#: Arrays up to this length are written with Python's shortest round-trip repr; longer ones
+#: (control nets) with 17 significant digits, which is as exact and about twice as fast.
+SHORTEST_REPR_SIZE = 256
+#: Default minimum user-intended resolution (Global field 19), in file units.
+DEFAULT_RESOLUTION = 1e-7
+#: Parameter data occupy columns 1-64 of a P line (IGES 5.3 §2.2.4.5).
+PD_COLUMNS = 64
+#: Start and Global data occupy columns 1-72.
+DATA_COLUMNS = 72
+#: Entities nested deeper than this are refused (records cannot be cyclic, but be safe).
+MAX_DEPTH = 256
+START_TEXT = "Bladesmith exact NURBS geometry, IGES 5.3 fixed format."
+
+_EXPONENT = re.compile(r"(\d+)(\.\d*)?e")
+
+
+def _fix_exponent(m: re.Match) -> str:
+    return m.group(1) + (m.group(2) or ".") + "E"
+
+
+def format_real(x: float) -> str:
+    """An IGES real constant that reads back as exactly ``x`` (IGES 5.3 §2.2.2.3).
+
+    Python's shortest round-trip repr, with a decimal point always present and the
+    exponent letter E (``1e-05`` -> ``1.E-05``).
+    """
+    s = repr(float(x))
+    return _EXPONENT.sub(_fix_exponent, s) if "e" in s else s
+
+
+def _reals(values) -> str:
+    """Comma-separated :func:`format_real` of all values, fast for large arrays."""
+    a = np.asarray(values, dtype=np.float64).ravel()
+    if a.size > 1 and np.all(a == a[0]) and not (a[0] == 0 and np.any(np.signbit(a))):
+        return ",".join([format_real(a[0])] * a.size)  # e.g. the unit weights of a polynomial surface
+    mag = np.abs(a)
+    if a.size <= SHORTEST_REPR_SIZE:
+        strs = list(map(repr, a.tolist()))
+        # repr switches to exponent notation below 1e-4 and from 1e16 on: fix only those
+        for i in np.flatnonzero((mag != 0) & ((mag < 1e-4) | (mag >= 1e16))).tolist():
+            strs[i] = format_real(a[i])
+        return ",".join(strs)
+    # Bulk data: 17 significant digits (max_digits10, exact for every double) in one
+    # C-level format call; the few integral or exponent-form values are written by
+    # format_real so that every real keeps its decimal point.
+    fmt = ["%.17g"] * a.size
+    args = a.tolist()
+    for i in np.flatnonzero((a == np.trunc(a)) | (mag < 1e-4) | (mag >= 1e17)).tolist():
+        fmt[i] = "%s"
+        args[i] = format_real(args[i])
+    return ",".join(fmt) % tuple(args)
+
+
+def hollerith(text: str) -> str:
+    return f"{len(text)}H{text}" if text else ""
+
+
+# -- entity ordering and roles -------------------------------------------------------------------
+def _children(entity: Entity):
+    refs = list(entity.references())
+    if entity.transform is not None:
+        refs.append(entity.transform)
+    return refs
+
+
+def collect(roots) -> list[Entity]:
+    """All entities reachable from ``roots``, each once, every entity after the ones it
+    references (so a file we read and write again keeps its order)."""
+    order: list[Entity] = []
+    state: dict[int, int] = {}
+
+    def visit(e, depth):
+        if not isinstance(e, Entity):
+            raise IgesError(f"expected an IGES record, got {type(e).__name__}")
+        s = state.get(id(e))
+        if s == 2:
+            return
+        if s == 1:
+            raise IgesError(f"{e.describe()} references itself (cycle)")
+        if depth > MAX_DEPTH:
+            raise IgesError(f"{e.describe()}: references nested deeper than {MAX_DEPTH}")
+        state[id(e)] = 1
+        for c in _children(e):
+            visit(c, depth + 1)
+        state[id(e)] = 2
+        order.append(e)
+
+    for r in roots:
+        visit(r, 0)
+    return order
+
+
+def _parameter_space(order) -> set[int]:
+    """ids of entities used as parameter-space curves (the B of a 142), with constituents."""
+    out: set[int] = set()
+
+    def mark(e):
+        if id(e) in out:
+            return
+        out.add(id(e))
+        if isinstance(e, CompositeCurve):
+            for c in e.curves:
+                mark(c)
+
+    for e in order:
+        if isinstance(e, CurveOnSurface) and e.parameter_curve is not None:
+            mark(e.parameter_curve)
+    return out
+
+
+def _status(entity, referenced: set, param: set) -> str:
+    """DE field 9 (IGES 5.3 §2.2.4.4.9): blank, subordinate, use, hierarchy, 2 digits each.
+
+    Subordinate 01 (physically dependent) for every entity another one points to; use
+    flag 05 (2-D parametric) for parameter-space curves, 02 (definition) for matrices,
+    else 00 (geometry).
+    """
+    sub = 1 if id(entity) in referenced else 0
+    if id(entity) in param:
+        use = 5
+    elif isinstance(entity, TransformationMatrix):
+        use = 2
+    else:
+        use = 0
+    return f"00{sub:02d}{use:02d}00"
+
+
+# -- parameter data ------------------------------------------------------------------------------
+def _pd(entity: Entity, de: dict, resolution: float) -> str:
+    """The parameter string of one entity, delimited by ',' and ended by ';'."""
+    t = entity.type_number
+    if isinstance(entity, BSplineSurface128):
+        P = entity.control_points
+        nu, nv = P.shape[:2]
+        flags = surface_flags(entity, resolution)
+        (u0, u1), (v0, v1) = entity.parameter_range_u, entity.parameter_range_v
+        parts = [
+            "128", str(nu - 1), str(nv - 1), str(entity.degree_u), str(entity.degree_v),
+            *map(str, flags),
+            _reals(entity.knots_u), _reals(entity.knots_v),
+            _reals(entity.weights.T),  # W(0,0), W(1,0), ...: the u index varies fastest
+            _reals(P.transpose(1, 0, 2)),
+            _reals([u0, u1, v0, v1]),
+        ]
+    elif isinstance(entity, BSplineCurve126):
+        planar, closed, poly, periodic, normal = curve_flags(entity, resolution)
+        n = entity.control_points.shape[0]
+        parts = [
+            "126", str(n - 1), str(entity.degree), str(planar), str(closed), str(poly), str(periodic),
+            _reals(entity.knots), _reals(entity.weights), _reals(entity.control_points),
+            _reals(entity.parameter_range), _reals(normal),
+        ]
+    elif isinstance(entity, Line):
+        parts = ["110", _reals(entity.start), _reals(entity.end)]
+    elif isinstance(entity, CircularArc):
+        parts = ["100", format_real(entity.z), _reals(entity.center), _reals(entity.start), _reals(entity.end)]
+    elif isinstance(entity, CompositeCurve):
+        parts = ["102", str(len(entity.curves)), *(str(de[id(c)]) for c in entity.curves)]
+    elif isinstance(entity, CurveOnSurface):
+        parts = [
+            "142", str(entity.creation), str(de[id(entity.surface)]),
+            str(de[id(entity.parameter_curve)]) if entity.parameter_curve is not None else "0",
+            str(de[id(entity.model_curve)]) if entity.model_curve is not None else "0",
+            str(entity.preferred),
+        ]
+    elif isinstance(entity, TrimmedSurface):
+        parts = [
+            "144", str(de[id(entity.surface)]), "0" if entity.outer is None else "1", str(len(entity.inner)),
+            "0" if entity.outer is None else str(de[id(entity.outer)]),
+            *(str(de[id(c)]) for c in entity.inner),
+        ]
+    elif isinstance(entity, SurfaceOfRevolution):
+        parts = ["120", str(de[id(entity.axis)]), str(de[id(entity.generatrix)]),
+                 format_real(entity.start_angle), format_real(entity.end_angle)]
+    elif isinstance(entity, TransformationMatrix):
+        M = np.concatenate([entity.rotation, entity.translation[:, None]], axis=1)
+        parts = ["124", _reals(M)]
+    elif isinstance(entity, ParametricSpline):
+        T = entity.breakpoints
+        parts = ["112", str(entity.spline_type), str(entity.continuity), str(entity.ndim), str(T.size - 1),
+                 _reals(T), _reals(entity.coefficients), _reals(entity.terminal)]
+    elif isinstance(entity, ParametricSplineSurface):
+        TU, TV, C = entity.breakpoints_u, entity.breakpoints_v, entity.coefficients
+        M, N = TU.size - 1, TV.size - 1
+        zeros48 = ",".join(["0.0"] * 48)
+        parts = ["114", str(entity.spline_type), str(entity.patch_type), str(M), str(N), _reals(TU), _reals(TV)]
+        for i in range(M):
+            parts.extend(_reals(C[i, j]) for j in range(N))
+            parts.append(zeros48)  # the arbitrary patch (i, N+1)
+        parts.extend([zeros48] * (N + 1))  # the arbitrary row M+1
+    else:
+        raise IgesError(f"{entity.describe()}: cannot be written")
+    assert parts[0] == str(t)
+    return ",".join(parts) + ";"
+
+
+#: Greedy line filling: the longest run of at most PD_COLUMNS characters ending in a delimiter.
+_PD_LINE = re.compile(r".{0,%d}[,;]" % (PD_COLUMNS - 1), re.DOTALL)
+
+
+def _pack(s: str, width: int = PD_COLUMNS) -> list[str]:
+    """Split a parameter string at delimiters into chunks of at most ``width`` columns.
+
+    Only for strings without Hollerith constants (numbers never contain ',' or ';').
+    """
+    if width == PD_COLUMNS:
+        out = _PD_LINE.findall(s)
+        if sum(map(len, out)) == len(s):
+            return out
+    out = []
+    pos, n = 0, len(s)
+    while n - pos > width:
+        cut = s.rfind(",", pos, pos + width)
+        if cut < 0:
+            raise IgesError(f"a parameter is longer than {width} columns: {s[pos:pos + 40]}...")
+        out.append(s[pos : cut + 1])
+        pos = cut + 1
+    out.append(s[pos:])
+    return out
+
+
+def _pack_tokens(tokens: list[str], width: int) -> list[str]:
+    """Pack delimited tokens into lines; Hollerith strings longer than a line are split."""
+    lines, cur = [], ""
+    for tok in tokens:
+        if len(cur) + len(tok) <= width:
+            cur += tok
+            continue
+        if len(tok) > width:  # only strings get this long: continue them on the next lines
+            room = width - len(cur)
+            cur += tok[:room]
+            tok = tok[room:]
+            lines.append(cur)
+            while len(tok) > width:
+                lines.append(tok[:width])
+                tok = tok[width:]
+            cur = tok
+        else:
+            lines.append(cur)
+            cur = tok
+    if cur:
+        lines.append(cur)
+    return lines
+
+
+# -- header -----------------------------------------------------------------------------------
+def _timestamp(when: _dt.datetime | None) -> str:
+    when = when or _dt.datetime.now(_dt.timezone.utc)
+    return when.strftime("%Y%m%d.%H%M%S")
+
+
+def _extent(order, param: set) -> float:
+    """Approximate maximum coordinate (Global field 20) over model-space entities."""
+    m = 0.0
+    for e in order:
+        if id(e) in param:
+            continue
+        if isinstance(e, (BSplineCurve126, BSplineSurface128)):
+            P = e.control_points
+        elif isinstance(e, Line):
+            P = np.stack([e.start, e.end])
+        elif isinstance(e, CircularArc):
+            r = e.radius
+            P = np.array([[abs(e.center[0]) + r, abs(e.center[1]) + r, e.z]])
+        elif isinstance(e, ParametricSpline):
+            P = e.coefficients[..., 0]
+        elif isinstance(e, ParametricSplineSurface):
+            P = e.coefficients[..., 0]
+        else:
+            continue
+        if e.transform is not None:
+            from .convert import _transform
+            P = _transform(e, P.reshape(-1, 3))
+        if P.size:
+            m = max(m, float(np.max(np.abs(P))))
+    return m
+
+
+def _check_text(text: str, what: str):
+    if not all(32 <= ord(ch) < 127 for ch in text):
+        raise IgesError(f"{what} must be printable ASCII, got {text!r:.80}")
+
+
+def _check_header(h: GlobalSection):
+    for name, kind in GLOBAL_FIELDS:
+        value = getattr(h, name)
+        if kind == "s":
+            if not isinstance(value, str):
+                raise IgesError(f"Global section {name}: expected a string, got {value!r:.60}")
+            _check_text(value, f"Global section {name}")
+        elif kind == "i":
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise IgesError(f"Global section {name}: expected an integer, got {value!r:.60}")
+        else:
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise IgesError(f"Global section {name}: expected a finite real, got {value!r:.60}")
+    if (h.parameter_delimiter, h.record_delimiter) != (",", ";"):
+        raise IgesError("the writer uses the default delimiters ',' and ';' only")
+    if not h.resolution > 0:
+        raise IgesError(f"the resolution (Global field 19) must be > 0, got {h.resolution!r}")
+    if not h.model_scale > 0:
+        raise IgesError(f"the model-space scale (Global field 13) must be > 0, got {h.model_scale!r}")
+    if h.unit_flag not in UNIT_NAMES and h.unit_flag != 3:
+        raise IgesError(f"unknown unit flag (Global field 14): {h.unit_flag}")
+    if h.unit_flag != 3 and h.unit_name != UNIT_NAMES[h.unit_flag]:
+        raise IgesError(f"unit name {h.unit_name!r} does not match unit flag {h.unit_flag} "
+                        f"({UNIT_NAMES[h.unit_flag]!r})")
+    for name in ("created", "modified"):
+        v = getattr(h, name)
+        if v and not re.fullmatch(r"\d{8}\.\d{6}", v):
+            raise IgesError(f"Global section {name}: expected YYYYMMDD.HHNNSS, got {v!r}")
+
+
+def make_header(*, units: str = "m", resolution: float = DEFAULT_RESOLUTION, file_name: str = "",
+                author: str = "", organization: str = "", product_id: str = "",
+                timestamp: _dt.datetime | None = None, max_coordinate: float = 0.0,
+                model_scale: float = 1.0) -> GlobalSection:
+    """A Global section for a new file; ``units`` is a key of :data:`UNITS`."""
+    try:
+        flag, name = UNITS[units.lower()]
+    except (KeyError, AttributeError):
+        raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}") from None
+    stamp = _timestamp(timestamp)
+    product = product_id or os.path.splitext(os.path.basename(file_name))[0] or "bladesmith"
+    return GlobalSection(
+        product_id=product, file_name=file_name, receiver_product_id=product,
+        model_scale=float(model_scale), unit_flag=flag, unit_name=name,
+        max_line_weight=float(resolution), created=stamp, resolution=float(resolution),
+        max_coordinate=float(max_coordinate), author=author, organization=organization, modified=stamp,
+    )
+
+
+def _global_lines(h: GlobalSection) -> list[str]:
+    tokens = []
+    for name, kind in GLOBAL_FIELDS:
+        v = getattr(h, name)
+        if kind == "s":
+            tokens.append(hollerith(v))
+        elif kind == "i":
+            tokens.append(str(v))
+        else:
+            tokens.append(format_real(v))
+    tokens = [t + "," for t in tokens[:-1]] + [tokens[-1] + ";"]
+    return _pack_tokens(tokens, DATA_COLUMNS)
+
+
+# -- the file -----------------------------------------------------------------------------------
+def to_string(entities, *, units: str = "m", resolution: float | None = None, header: GlobalSection | None = None,
+              start: str | None = None, file_name: str = "", author: str = "", organization: str = "",
+              timestamp: _dt.datetime | None = None) -> str:
+    """The IGES file for ``entities`` (records, or an :class:`IgesModel` read before) as text.
+
+    Entities that the given ones reference are written too. ``header`` (a
+    :class:`GlobalSection`) overrides units/resolution/author/...; a model read from a file
+    carries its own header and start text, so write -> read -> write is byte-identical.
+    Raises :class:`IgesError` for inconsistent data, before anything is produced.
+    """
+    from .reader import IgesModel
+
+    if isinstance(entities, IgesModel):
+        header = header or entities.header
+        start = entities.start if start is None else start
+        entities = entities.entities
+    elif isinstance(entities, Entity):
+        entities = [entities]
+    try:
+        roots = list(entities)
+    except TypeError:
+        raise IgesError(f"expected a sequence of IGES records, got {type(entities).__name__}") from None
+    order = collect(roots)
+    param = _parameter_space(order)
+    if header is None:
+        header = make_header(units=units, resolution=DEFAULT_RESOLUTION if resolution is None else resolution,
+                             file_name=file_name, author=author, organization=organization,
+                             timestamp=timestamp, max_coordinate=_extent(order, param))
+    elif resolution is not None:
+        raise IgesError("give the resolution either in the header or as resolution=, not both")
+    _check_header(header)
+    res = header.resolution
+
+    # 1. validate everything (no output yet)
+    try:
+        for e in order:
+            if isinstance(e, GenericEntity):
+                raise IgesError(f"{e.describe()}: entities of unsupported types cannot be written")
+            if not isinstance(e.label, str) or len(e.label) > 8:
+                raise IgesError(f"{e.describe()}: labels have at most 8 characters")
+            _check_text(e.label, f"{e.describe()}: label")
+            if not -9_999_999 <= e.subscript <= 99_999_999:
+                raise IgesError(f"{e.describe()}: subscript {e.subscript} does not fit 8 columns")
+            validate_entity(e, res)
+        for e in order:
+            if isinstance(e, TrimmedSurface):
+                for loop in ((e.outer,) if e.outer is not None else ()) + e.inner:
+                    validate_loop(loop, res)
+    except BladesmithError as exc:
+        if isinstance(exc, IgesError):
+            raise
+        raise IgesError(str(exc)) from None
+
+    # 2. serialise
+    referenced = {id(c) for e in order for c in _children(e)}
+    de = {id(e): 2 * i + 1 for i, e in enumerate(order)}
+    if 2 * len(order) > 9_999_999:
+        raise IgesError("too many entities for 7-digit sequence numbers")
+    start_lines = [ln for ln in (start if start is not None else START_TEXT).splitlines()] or [""]
+    s_lines = []
+    for ln in start_lines:
+        _check_text(ln, "start section text")
+        s_lines.extend(ln[i : i + DATA_COLUMNS] for i in range(0, max(len(ln), 1), DATA_COLUMNS))
+    out = [f"{ln:<72}S{i:07d}" for i, ln in enumerate(s_lines, 1)]
+    g_lines = _global_lines(header)
+    out += [f"{ln:<72}G{i:07d}" for i, ln in enumerate(g_lines, 1)]
+    d_out, p_out = [], []
+    pseq = 1
+    for e in order:
+        seq = de[id(e)]
+        chunks = _pack(_pd(e, de, res), PD_COLUMNS)
+        # one C-level format for all lines of the entity: "%-64s" data, back-pointer, sequence
+        fmt = ("%%-64s %7dP%%07d" % seq,) * len(chunks)
+        p_out.append("\n".join(fmt) % tuple(chain.from_iterable(zip(chunks, range(pseq, pseq + len(chunks))))))
+        t = e.type_number
+        tr = de[id(e.transform)] if e.transform is not None else 0
+        status = _status(e, referenced, param)
+        d_out.append(f"{t:8d}{pseq:8d}{0:8d}{0:8d}{0:8d}{0:8d}{tr:8d}{0:8d}{status}D{seq:07d}")
+        d_out.append(f"{t:8d}{0:8d}{0:8d}{len(chunks):8d}{e.form:8d}{'':8}{'':8}{e.label:>8}"
+                     f"{e.subscript:8d}D{seq + 1:07d}")
+        pseq += len(chunks)
+    if pseq - 1 > 9_999_999:
+        raise IgesError("too many parameter lines for 7-digit sequence numbers")
+    out += d_out
+    out += p_out
+    term = f"S{len(s_lines):7d}G{len(g_lines):7d}D{len(d_out):7d}P{pseq - 1:7d}"
+    out.append(f"{term:<72}T{1:07d}")
+    out.append("")
+    return "\n".join(out)
+
+
+def write_iges(path, entities, **options) -> str:
+    """Write ``entities`` to ``path`` atomically; returns the path. Options as :func:`to_string`.
+
+    The text is complete before the file system is touched; it then goes to a
+    temporary file in the same folder, which replaces ``path`` in one ``os.replace``.
+    """
+    path = os.fspath(path)
+    options.setdefault("file_name", os.path.basename(path))
+    text = to_string(entities, **options)
+    atomic_write(path, text.encode("ascii"))
+    return path
+
+
+def atomic_write(path: str, data: bytes) -> None:
+    """Write ``data`` to ``path`` via a temporary file in the same folder and ``os.replace``."""
+    folder = os.path.dirname(os.path.abspath(path))
+    try:
+        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise IgesError(f"cannot create a temporary file in {folder}: {exc}", path=path) from exc
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException as exc:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        if isinstance(exc, OSError):
+            raise IgesError(f"cannot write the file: {exc}", path=path) from exc
+        raise
