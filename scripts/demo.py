@@ -94,15 +94,12 @@ def main(argv=None) -> int:
     blend = out / "demo.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
     print(f"wrote {blend}")
-    try:
-        from bladesmith.iges import write_iges
-        from bladesmith.iges.convert import curve_to_record, surface_to_record
-    except ImportError:
-        print("IGES writer not available yet: no .igs written")
-    else:
-        igs = out / "demo.igs"
-        write_iges(igs, [surface_to_record(surface), curve_to_record(leading_edge)], units="m")
-        print(f"wrote {igs}")
+    from bladesmith.iges import curve_from_geometry, surface_from_geometry, write_iges
+
+    igs = out / "demo.igs"
+    write_iges(igs, [surface_from_geometry(surface, label="BLADE"), curve_from_geometry(leading_edge, label="MIDCHORD")],
+               units="m")
+    print(f"wrote {igs}")
     print(f"done in {time.perf_counter() - start:.2f} s")
     addon.unregister()
     return 0

@@ -1,0 +1,261 @@
+"""File > Export > IGES and File > Import > IGES.
+
+Export writes every selected (or every) NURBS surface and curve object: Bladesmith objects
+from their exact float64 data, hand-edited or native Blender NURBS, poly and Bezier curves
+from their Blender data with the knot vectors Blender really uses
+(:func:`..operators.nurbs_objects.object_to_geometry`). Object transforms are applied to
+the control points (NURBS are affine invariant, so this is exact up to the float32
+matrix Blender stores; identity transforms are skipped and cost nothing).
+
+Import creates exact NURBS objects for 126/128 (and 100, 110, 112, 114, 120 converted to
+B-splines); a trimmed surface (144) comes in as its untrimmed surface plus its trimming
+curves, and the report says so. A failure leaves the scene as it was.
+"""
+from __future__ import annotations
+
+import os
+
+import bpy
+import numpy as np
+from bpy.props import BoolProperty, EnumProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
+
+from ..geometry.errors import BladesmithError
+from ..geometry.nurbs import BSplineCurve, BSplineSurface
+from ..geometry.nurbs.fitting import approximate
+from ..iges import (
+    TrimmedSurfaceGeometry,
+    curve_from_geometry,
+    read_iges,
+    surface_from_geometry,
+    write_iges,
+)
+from ..iges.convert import surface_points, surface_range
+from .nurbs_objects import curve_to_object, object_to_geometry, surface_to_object
+
+#: Metres per unit for the IGES unit names Bladesmith writes and reads.
+METRES_PER_UNIT = {
+    "IN": 0.0254, "MM": 1e-3, "FT": 0.3048, "MI": 1609.344, "M": 1.0, "KM": 1000.0,
+    "MIL": 2.54e-5, "UM": 1e-6, "CM": 0.01, "UIN": 2.54e-8,
+}
+#: Trimming curves of an imported 144 are approximated on the surface to this fraction of
+#: the surface's size (they have no exact model-space form when the file gives none).
+TRIM_CURVE_TOL = 1e-6
+
+EXPORTABLE_TYPES = {"SURFACE", "CURVE"}
+
+
+def _world_geometry(obj) -> list:
+    """The object's curves and surfaces in world coordinates, float64."""
+    pieces = object_to_geometry(obj)
+    M = np.array(obj.matrix_world, dtype=np.float64)
+    if np.array_equal(M, np.eye(4)):
+        return pieces
+    out = []
+    for g in pieces:
+        P = g.control_points
+        P3 = np.zeros(P.shape[:-1] + (3,))
+        P3[..., : P.shape[-1]] = P
+        moved = P3 @ M[:3, :3].T + M[:3, 3]
+        if isinstance(g, BSplineSurface):
+            out.append(BSplineSurface(g.degree_u, g.degree_v, g.knots_u, g.knots_v, moved, g.weights))
+        else:
+            out.append(BSplineCurve(g.degree, g.knots, moved, g.weights))
+    return out
+
+
+def export_objects(objects, filepath: str, units: str = "M", progress=None) -> dict:
+    """Write the NURBS of ``objects`` to ``filepath`` (atomically). Returns counts.
+
+    Raises :class:`BladesmithError` (nothing is written then) when an object cannot be
+    expressed exactly or the data is inconsistent.
+    """
+    scale = 1.0 / METRES_PER_UNIT[units]
+    records, counts = [], {"surfaces": 0, "curves": 0, "objects": 0}
+    objects = [o for o in objects if o.type in EXPORTABLE_TYPES]
+    for i, obj in enumerate(objects):
+        try:
+            pieces = _world_geometry(obj)
+        except BladesmithError as exc:
+            raise type(exc)(f"object '{obj.name}': {exc}") from None
+        for k, g in enumerate(pieces):
+            label = obj.name if len(pieces) == 1 else f"{obj.name}.{k}"
+            if isinstance(g, BSplineSurface):
+                records.append(surface_from_geometry(g, scale=scale, label=label[:8]))
+                counts["surfaces"] += 1
+            else:
+                records.append(curve_from_geometry(g, scale=scale, label=label[:8]))
+                counts["curves"] += 1
+        counts["objects"] += 1
+        if progress:
+            progress(i + 1, len(objects))
+    if not records:
+        raise BladesmithError("nothing to export: no NURBS surface or curve objects")
+    write_iges(filepath, records, units=units.lower())
+    return counts
+
+
+def _trim_curve_on_surface(surface_record, curve: BSplineCurve, size: float) -> BSplineCurve:
+    """A model-space B-spline of S(c(t)) within :data:`TRIM_CURVE_TOL` of ``size``.
+
+    The loop ``c`` is in the IGES parameter space of the basis surface record (for a 120,
+    v is the rotation angle), so S is evaluated through the record, not through its
+    NURBS conversion, whose parameterisation differs."""
+    a, b = curve.domain
+    (u0, u1), (v0, v1) = surface_range(surface_record)
+
+    def on_surface(t):
+        uv = curve.evaluate(t)
+        return surface_points(surface_record, np.clip(uv[..., 0], u0, u1), np.clip(uv[..., 1], v0, v1))
+
+    return approximate(on_surface, TRIM_CURVE_TOL * size, degree=3, domain=(a, b))
+
+
+def import_file(filepath: str, collection, progress=None) -> dict:
+    """Create objects for the curves and surfaces of an IGES file in ``collection``.
+
+    Returns counts; on any :class:`BladesmithError` the objects made so far are removed
+    and the error propagates, so the scene is unchanged.
+    """
+    model = read_iges(filepath)
+    unit = model.header.unit_name.upper() if model.header.unit_name else "M"
+    factor = METRES_PER_UNIT.get(unit, 1.0) / (model.header.model_scale or 1.0)
+    items = model.to_geometry()
+    created = []
+    counts = {"surfaces": 0, "curves": 0, "trimmed": 0, "trim_curves": 0}
+    base = os.path.splitext(os.path.basename(filepath))[0]
+
+    def scaled(g):
+        P = np.asarray(g.control_points) * factor
+        if isinstance(g, BSplineSurface):
+            return BSplineSurface(g.degree_u, g.degree_v, g.knots_u, g.knots_v, P, g.weights)
+        return BSplineCurve(g.degree, g.knots, P, g.weights)
+
+    try:
+        for i, (record, geometry) in enumerate(items):
+            name = (record.label or f"{base}.{record.type_number}").strip() or base
+            if isinstance(geometry, TrimmedSurfaceGeometry):
+                created.append(surface_to_object(scaled(geometry.surface), name, collection))
+                counts["trimmed"] += 1
+                for loop in ([geometry.outer] if geometry.outer else []) + list(geometry.inner):
+                    for c in loop:
+                        trim = _trim_curve_on_surface(record.surface, c, geometry.surface.size())
+                        created.append(curve_to_object(scaled(trim), f"{name}.trim", collection))
+                        counts["trim_curves"] += 1
+            elif isinstance(geometry, BSplineSurface):
+                created.append(surface_to_object(scaled(geometry), name, collection))
+                counts["surfaces"] += 1
+            else:
+                for c in geometry if isinstance(geometry, list) else [geometry]:
+                    for piece in c if isinstance(c, list) else [c]:
+                        created.append(curve_to_object(scaled(piece), name, collection))
+                        counts["curves"] += 1
+            if progress:
+                progress(i + 1, len(items))
+    except BladesmithError:
+        for obj in created:
+            data = obj.data
+            bpy.data.objects.remove(obj)
+            if data is not None and data.users == 0:
+                bpy.data.curves.remove(data)
+        raise
+    counts["objects"] = created
+    return counts
+
+
+class _Progress:
+    def __init__(self, context):
+        self.wm = context.window_manager
+
+    def __enter__(self):
+        self.wm.progress_begin(0, 100)
+        return lambda done, total: self.wm.progress_update(int(100 * done / max(total, 1)))
+
+    def __exit__(self, *exc):
+        self.wm.progress_end()
+        return False
+
+
+UNIT_ITEMS = [
+    ("M", "Metres", "Write coordinates in metres (IGES unit flag 6)"),
+    ("MM", "Millimetres", "Write coordinates in millimetres (IGES unit flag 2)"),
+    ("IN", "Inches", "Write coordinates in inches (IGES unit flag 1)"),
+]
+
+
+class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
+    """Write NURBS surfaces and curves to an IGES 5.3 file"""
+
+    bl_idname = "export_scene.iges"
+    bl_label = "Export IGES"
+    bl_options = {"PRESET"}
+
+    filename_ext = ".igs"
+    filter_glob: StringProperty(default="*.igs;*.iges", options={"HIDDEN"})
+    use_selection: BoolProperty(name="Selected Only", description="Export the selected objects only", default=False)
+    units: EnumProperty(name="Units", items=UNIT_ITEMS, default="M")
+
+    def execute(self, context):
+        objects = context.selected_objects if self.use_selection else context.scene.objects
+        try:
+            with _Progress(context) as progress:
+                counts = export_objects(objects, self.filepath, self.units, progress)
+        except BladesmithError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        self.report(
+            {"INFO"},
+            f"Wrote {counts['surfaces']} surfaces and {counts['curves']} curves from {counts['objects']} "
+            f"objects to {self.filepath} ({self.units.lower()})",
+        )
+        return {"FINISHED"}
+
+
+class IMPORT_SCENE_OT_iges(bpy.types.Operator, ImportHelper):
+    """Read the curves and surfaces of an IGES file as exact NURBS objects"""
+
+    bl_idname = "import_scene.iges"
+    bl_label = "Import IGES"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filename_ext = ".igs"
+    filter_glob: StringProperty(default="*.igs;*.iges", options={"HIDDEN"})
+
+    def execute(self, context):
+        try:
+            with _Progress(context) as progress:
+                counts = import_file(self.filepath, context.collection, progress)
+        except BladesmithError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        message = f"Imported {counts['surfaces']} surfaces and {counts['curves']} curves"
+        if counts["trimmed"]:
+            message += (
+                f"; {counts['trimmed']} trimmed surfaces came in untrimmed, with their "
+                f"{counts['trim_curves']} trimming curves as separate curve objects"
+            )
+        self.report({"INFO"}, message)
+        return {"FINISHED"}
+
+
+def _menu_export(self, context):
+    self.layout.operator(EXPORT_SCENE_OT_iges.bl_idname, text="IGES (.igs/.iges)")
+
+
+def _menu_import(self, context):
+    self.layout.operator(IMPORT_SCENE_OT_iges.bl_idname, text="IGES (.igs/.iges)")
+
+
+_register, _unregister = bpy.utils.register_classes_factory((EXPORT_SCENE_OT_iges, IMPORT_SCENE_OT_iges))
+
+
+def register():
+    _register()
+    bpy.types.TOPBAR_MT_file_export.append(_menu_export)
+    bpy.types.TOPBAR_MT_file_import.append(_menu_import)
+
+
+def unregister():
+    bpy.types.TOPBAR_MT_file_import.remove(_menu_import)
+    bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
+    _unregister()

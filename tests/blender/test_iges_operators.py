@@ -1,0 +1,189 @@
+"""File > Export > IGES and File > Import > IGES in Blender."""
+import os
+
+import bpy
+import numpy as np
+import pytest
+
+from bladesmith.geometry.nurbs import BSplineCurve, BSplineSurface
+from bladesmith.geometry.nurbs.projection import closest_point_surface
+from bladesmith.iges import read_iges
+from bladesmith.operators.nurbs_objects import curve_to_object, object_to_geometry, surface_to_object
+
+FLOAT32 = 2e-6  # relative: the float32 precision of Blender coordinates, with margin
+
+
+def random_surface(rng, rational):
+    nu, nv = 7, 6
+    ku = np.r_[[0] * 4, np.sort(rng.uniform(0.1, 0.9, nu - 4)), [1] * 4]
+    kv = np.r_[[0] * 4, np.sort(rng.uniform(0.1, 0.9, nv - 4)), [1] * 4]
+    x, y = np.meshgrid(np.linspace(0, 1, nu), np.linspace(0, 1, nv), indexing="ij")
+    net = np.stack([x, y, 0.2 * rng.normal(size=x.shape)], axis=-1)
+    w = rng.uniform(0.5, 2.0, (nu, nv)) if rational else None
+    return BSplineSurface(3, 3, ku, kv, net, w)
+
+
+def scene_snapshot():
+    return {
+        "objects": set(bpy.data.objects.keys()),
+        "curves": set(bpy.data.curves.keys()),
+        "meshes": set(bpy.data.meshes.keys()),
+    }
+
+
+def test_export_writes_exact_float64_data(scene, tmp_path):
+    rng = np.random.default_rng(1)
+    surfaces = [random_surface(rng, r) for r in (False, True)]
+    for i, s in enumerate(surfaces):
+        surface_to_object(s, f"S{i}")
+    curve = BSplineCurve(3, [0, 0, 0, 0, 0.4, 1, 1, 1, 1], rng.normal(size=(5, 3)), rng.uniform(0.5, 2, 5))
+    curve_to_object(curve, "C")
+    path = tmp_path / "out.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(path)) == {"FINISHED"}
+    model = read_iges(path)
+    geometry = [g for _, g in model.to_geometry()]
+    got_surfaces = [g for g in geometry if isinstance(g, BSplineSurface)]
+    got_curves = [g for g in geometry if isinstance(g, BSplineCurve)]
+    assert len(got_surfaces) == 2 and len(got_curves) == 1
+    for s in surfaces:
+        match = [g for g in got_surfaces if g.shape == s.shape and g.is_rational == s.is_rational]
+        assert match and np.array_equal(match[0].control_points, s.control_points)  # bitwise: float64 data
+    assert np.array_equal(got_curves[0].weights, curve.weights)
+
+
+def test_export_units_and_selection(scene, tmp_path):
+    rng = np.random.default_rng(2)
+    a = surface_to_object(random_surface(rng, False), "A")
+    b = surface_to_object(random_surface(rng, False), "B")
+    for obj in scene.objects:
+        obj.select_set(obj is a)
+    path = tmp_path / "mm.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(path), use_selection=True, units="MM") == {"FINISHED"}
+    model = read_iges(path)
+    assert model.header.unit_flag == 2 and model.header.unit_name == "MM"
+    (record, g), = model.to_geometry()
+    original = object_to_geometry(a)[0]
+    assert np.allclose(g.control_points, 1000.0 * original.control_points, rtol=1e-15, atol=0)
+    assert b.name not in {r.label for r, _ in model.to_geometry()}
+
+
+def test_export_applies_object_transforms(scene, tmp_path):
+    rng = np.random.default_rng(3)
+    s = random_surface(rng, True)
+    obj = surface_to_object(s, "Moved")
+    obj.location = (1.0, -2.0, 0.5)
+    obj.rotation_euler = (0.3, 0.0, 1.1)
+    bpy.context.view_layer.update()
+    path = tmp_path / "moved.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(path)) == {"FINISHED"}
+    (_, g), = read_iges(path).to_geometry()
+    M = np.array(obj.matrix_world, dtype=np.float64)
+    uv = rng.uniform(0, 1, (200, 2))
+    expected = s.evaluate(uv[:, 0], uv[:, 1]) @ M[:3, :3].T + M[:3, 3]
+    assert np.abs(g.evaluate(uv[:, 0], uv[:, 1]) - expected).max() < 1e-12 * s.size() * 10
+
+
+def test_hand_edited_native_nurbs_export_from_blender_data(scene, tmp_path):
+    bpy.ops.surface.primitive_nurbs_surface_torus_add()
+    torus = bpy.context.active_object
+    path = tmp_path / "torus.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(path)) == {"FINISHED"}
+    (_, g), = read_iges(path).to_geometry()
+    mesh = torus.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh()
+    V = np.array([v.co[:] for v in mesh.vertices], dtype=np.float64) @ np.array(torus.matrix_world)[:3, :3].T
+    torus.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh_clear()
+    _, _, d = closest_point_surface(g, V + np.array(torus.matrix_world)[:3, 3])
+    assert d.max() < FLOAT32 * g.size()
+
+
+def test_import_then_export_reproduces_surfaces(scene, tmp_path):
+    rng = np.random.default_rng(4)
+    surfaces = [random_surface(rng, r) for r in (False, True)]
+    from bladesmith.iges import surface_from_geometry, write_iges
+
+    source = tmp_path / "source.igs"
+    write_iges(source, [surface_from_geometry(s, label=f"S{i}") for i, s in enumerate(surfaces)])
+    assert bpy.ops.import_scene.iges(filepath=str(source)) == {"FINISHED"}
+    assert {o.name for o in scene.objects} == {"S0", "S1"}
+    # the imported objects are exact; edit nothing and export again
+    again = tmp_path / "again.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(again)) == {"FINISHED"}
+    back = {r.label: g for r, g in read_iges(again).to_geometry()}
+    uv = rng.uniform(0, 1, (500, 2))
+    for i, s in enumerate(surfaces):
+        err = np.abs(back[f"S{i}"].evaluate(uv[:, 0], uv[:, 1]) - s.evaluate(uv[:, 0], uv[:, 1])).max()
+        assert err < FLOAT32 * s.size(), err
+
+
+def test_import_of_a_trimmed_surface_reports_its_trimming_curves(scene, tmp_path):
+    from bladesmith.iges import examples, write_iges
+
+    path = tmp_path / "trimmed.igs"
+    trimmed, _area = examples.trimmed_cylinder_band()
+    write_iges(path, [trimmed])
+    assert bpy.ops.import_scene.iges(filepath=str(path)) == {"FINISHED"}
+    kinds = sorted(o.type for o in scene.objects)
+    # the band, its outer loop of four curves and the four arcs of the hole
+    assert kinds.count("SURFACE") == 1 and kinds.count("CURVE") == 8
+    band = next(o for o in scene.objects if o.type == "SURFACE")
+    surface = object_to_geometry(band)[0]
+    # the band is the cylinder x^2 + y^2 = 2^2, 0 <= z <= 3 between angles 0.25 and 2.75; the
+    # hole is a circle of radius 0.3 about (t, angle) = (0.5, 1.5) in IGES parameters
+    hole_points, rim_points = [], []
+    for obj in scene.objects:
+        if obj.type == "CURVE":
+            trim = object_to_geometry(obj)[0]
+            X = trim.evaluate(np.linspace(*trim.domain, 50))
+            _, _, d = closest_point_surface(surface, X)
+            assert d.max() < 1e-5 * surface.size()
+            t, angle = X[:, 2] / 3.0, np.arctan2(X[:, 1], X[:, 0])
+            on_hole = np.abs(np.hypot(t - 0.5, angle - 1.5) - 0.3) < 1e-5
+            (hole_points if on_hole.all() else rim_points).append(X)
+    assert len(hole_points) == 4 and len(rim_points) == 4
+
+
+def test_failed_import_leaves_the_scene_unchanged(scene, tmp_path):
+    rng = np.random.default_rng(5)
+    surface_to_object(random_surface(rng, False), "Existing")
+    before = scene_snapshot()
+    bad = tmp_path / "bad.igs"
+    bad.write_text("this is not an IGES file\n")
+    with pytest.raises(RuntimeError, match="IGES|line"):
+        bpy.ops.import_scene.iges(filepath=str(bad))
+    missing = tmp_path / "missing.igs"
+    with pytest.raises(RuntimeError):
+        bpy.ops.import_scene.iges(filepath=str(missing))
+    assert scene_snapshot() == before
+
+
+def test_failed_export_keeps_the_previous_file(scene, tmp_path, monkeypatch):
+    rng = np.random.default_rng(6)
+    surface_to_object(random_surface(rng, False), "S")
+    path = tmp_path / "keep.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(path)) == {"FINISHED"}
+    good = path.read_bytes()
+    # a surface Blender shows but IGES cannot hold: nothing may be written
+    from bladesmith.operators import iges_io
+
+    def broken(*args, **kwargs):
+        raise iges_io.BladesmithError("simulated failure halfway")
+
+    monkeypatch.setattr(iges_io, "curve_from_geometry", broken)
+    curve_to_object(BSplineCurve(1, [0, 0, 1, 1], [[0, 0, 0], [1, 1, 1]]), "C")
+    with pytest.raises(RuntimeError, match="simulated failure"):
+        bpy.ops.export_scene.iges(filepath=str(path))
+    assert path.read_bytes() == good
+    assert not [p for p in os.listdir(tmp_path) if p.endswith(".tmp")]
+
+
+def test_nothing_to_export_is_an_error(scene, tmp_path):
+    with pytest.raises(RuntimeError, match="nothing to export"):
+        bpy.ops.export_scene.iges(filepath=str(tmp_path / "empty.igs"))
+    assert not (tmp_path / "empty.igs").exists()
+
+
+def test_menus_are_registered(addon):
+    from bladesmith.operators import iges_io
+
+    assert iges_io._menu_export in bpy.types.TOPBAR_MT_file_export._dyn_ui_initialize()
+    assert iges_io._menu_import in bpy.types.TOPBAR_MT_file_import._dyn_ui_initialize()
