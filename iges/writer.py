@@ -16,11 +16,11 @@ import datetime as _dt
 import math
 import os
 import re
-import tempfile
 from itertools import chain
 
 import numpy as np
 
+from ..geometry.files import atomic_write as _atomic_write
 from ..geometry.errors import BladesmithError, IgesError
 from .records import (
     UNIT_NAMES,
@@ -495,23 +495,9 @@ def write_iges(path, entities, **options) -> str:
 
 
 def atomic_write(path: str, data: bytes) -> None:
-    """Write ``data`` to ``path`` via a temporary file in the same folder and ``os.replace``."""
-    folder = os.path.dirname(os.path.abspath(path))
+    """Write ``data`` to ``path`` atomically (:func:`..geometry.files.atomic_write`),
+    reporting failures as :class:`IgesError`."""
     try:
-        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
+        _atomic_write(path, data)
     except OSError as exc:
-        raise IgesError(f"cannot create a temporary file in {folder}: {exc}", path=path) from exc
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        if isinstance(exc, OSError):
-            raise IgesError(f"cannot write the file: {exc}", path=path) from exc
-        raise
+        raise IgesError(f"cannot write the file: {exc}", path=path) from exc

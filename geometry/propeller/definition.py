@@ -44,12 +44,12 @@ import io
 import math
 import os
 import pathlib
-import tempfile
 import tomllib
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
+from ..files import atomic_write
 from ..errors import DefinitionError
 
 RADIAL_FIELDS = ("r_R", "c_D", "P_D", "skew_deg", "rake_D", "t_c", "f_c")
@@ -409,15 +409,10 @@ class Propeller:
         """Write the definition (atomically: temporary file, then os.replace)."""
         path = pathlib.Path(path)
         text = dumps_toml(self.to_dict(relative_to=path.resolve().parent), header)
-        fd, tmp = tempfile.mkstemp(prefix=path.name, suffix=".tmp", dir=path.resolve().parent)
         try:
-            with os.fdopen(fd, "w", encoding="utf-8") as fh:
-                fh.write(text)
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+            atomic_write(path, text)
+        except OSError as exc:
+            raise DefinitionError(f"cannot write the definition: {exc}", path=str(path)) from exc
 
 
 def read_radial_csv(name, base_dir=None, source=None) -> RadialDistribution:

@@ -186,7 +186,7 @@ def test_successful_write_replaces_the_file(tmp_path):
 
 
 def test_unwritable_folder_is_an_iges_error(tmp_path):
-    with pytest.raises(IgesError, match="cannot create a temporary file"):
+    with pytest.raises(IgesError, match="cannot write the file.*No such file or directory"):
         write_iges(tmp_path / "missing" / "x.igs", [Line([0, 0, 0], [1, 0, 0])])
 
 
@@ -210,3 +210,27 @@ def test_the_package_never_imports_bpy():
             elif isinstance(node, ast.ImportFrom) and node.module:
                 names = [node.module]
             assert not any(n == "bpy" or n.startswith("bpy.") for n in names), path
+
+
+def test_written_files_get_ordinary_permissions(tmp_path):
+    """The temporary file is private; the result gets the mode open() would give it, or
+    keeps the mode of the file it replaces."""
+    import os
+    import stat
+
+    from bladesmith.iges import curve_from_geometry, write_iges
+    from bladesmith.geometry.nurbs import BSplineCurve
+
+    record = curve_from_geometry(BSplineCurve(1, [0, 0, 1, 1], [[0, 0, 0], [1, 0, 0]]))
+    umask = os.umask(0o022)
+    try:
+        fresh = tmp_path / "fresh.igs"
+        write_iges(fresh, [record])
+        assert stat.S_IMODE(fresh.stat().st_mode) == 0o644
+        kept = tmp_path / "kept.igs"
+        kept.write_text("old")
+        os.chmod(kept, 0o640)
+        write_iges(kept, [record])
+        assert stat.S_IMODE(kept.stat().st_mode) == 0o640
+    finally:
+        os.umask(umask)
