@@ -10,7 +10,6 @@ Never part of pass/fail (ARCHITECTURE.md, house style 10).
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import os
 import pathlib
 import statistics
@@ -20,19 +19,13 @@ import time
 
 import numpy as np
 
+from common import load_checkout
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
 def _load_bladesmith():
-    if "bladesmith" in sys.modules:
-        return sys.modules["bladesmith"]
-    spec = importlib.util.spec_from_file_location(
-        "bladesmith", ROOT / "__init__.py", submodule_search_locations=[str(ROOT)]
-    )
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["bladesmith"] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_checkout()
 
 
 def random_surfaces(count: int, size: int, seed: int = 0):
@@ -121,7 +114,7 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--surfaces", type=int, default=100)
     ap.add_argument("--size", type=int, default=40)
-    args = ap.parse_args(argv)
+    args = ap.parse_args([] if argv is None else argv)
 
     _load_bladesmith()
     from bladesmith.iges import surface_from_geometry
@@ -156,4 +149,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))
