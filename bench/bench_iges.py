@@ -21,7 +21,6 @@ import numpy as np
 
 from common import load_checkout
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
 def _load_bladesmith():
