@@ -1,5 +1,5 @@
 """Propellers after Hally (2013): the blade b(ξ, η) from a table of sections, the hub,
-the blade–hub intersection (tip smoothing and the hub sector build on these)."""
+the blade–hub intersection, and tip smoothing into five spline surfaces (§§3–9)."""
 from .blade import BladeSurface, SectionMeasurement
 from .definition import (
     HubDefinition,
@@ -12,6 +12,7 @@ from .definition import (
 from .hub import Hub
 from .intersection import BladeHubIntersection, blade_hub_intersection, solve_intersection
 from .model import PropellerModel
+from .smoothing import SmoothedBlade, SmoothingSettings, smooth_blade
 
 __all__ = [
     "BladeHubIntersection",
@@ -23,8 +24,11 @@ __all__ = [
     "RadialDistribution",
     "SectionDefinition",
     "SectionMeasurement",
+    "SmoothedBlade",
+    "SmoothingSettings",
     "blade_hub_intersection",
     "dumps_toml",
     "read_radial_csv",
+    "smooth_blade",
     "solve_intersection",
 ]

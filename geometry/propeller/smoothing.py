@@ -1,0 +1,446 @@
+"""Hally (2013) tip smoothing of the reference blade, §§3–9: settings, the pipeline and
+its report.
+
+``smooth_blade(model, settings)`` splits the blade b(ξ, η) into five surfaces (§3–4),
+computes the side curves (§5), the cuts (§6), smooths the cuts near the tip (§7), builds
+the curves around the edges and the tip (§8) and the spline surfaces with one common knot
+sequence and exactly shared edges (§9). The hub sector and IGES (§§10–11) live elsewhere.
+
+Units: every length setting is a fraction of the propeller radius R (dimensionless), so
+the defaults suit any size; ``transition_s`` is a fractional arclength along c_LETE.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, fields, replace
+
+import numpy as np
+
+from ..errors import DefinitionError, GeometryError
+from ..nurbs import BSplineCurve, BSplineSurface
+from ..nurbs.fitting import greville_abscissae
+from .blade_surfaces import (
+    DEGREE,
+    across_knots,
+    central_surface,
+    common_knots,
+    edge_surface,
+    evaluate_curves,
+    fit_rows,
+)
+from .corners import DefiningPoints, blade_derivatives, blade_points, check_corner_order, corner_points
+from .cut_smoothing import MAX_STABLE_FILTER_STRENGTH, curvature_sign_changes, spline_signed_curvature
+from .edge_curves import EdgeCurveSet, build_edge_curves
+from .side_curves import side_curves
+
+SURFACE_NAMES = ("pressure_central", "suction_central", "leading_edge", "trailing_edge", "tip")
+#: Documented bound on the deviation inside the smoothing zone, as a fraction of R.
+SMOOTHING_ZONE_BOUND = 5e-3
+#: Fraction of a tip-surface edge at each end left out of the normal-angle check: the
+#: tip surface meets c_9/c_12 (and c_10/c_12, c_9/c_11, c_10/c_11) at corners where its
+#: boundary curves continue each other (corner angle ~180°), so S_u and S_v are nearly
+#: parallel there and the normal is undefined (a property of Hally's five-surface layout).
+TIP_CORNER_EXCLUSION = 0.02
+#: Newton iterations of the closest-point projection onto b.
+PROJECTION_ITERATIONS = 12
+
+
+@dataclass(frozen=True)
+class SmoothingSettings:
+    """Settings of Hally (2013) tip smoothing. Lengths are fractions of the radius R.
+
+    delta_c: Δc of Hally Eqs. 31 and 49, the largest spacing of the curves along the
+        leading and trailing edges. Default 0.02 (0.01 D).
+    tip_smoothing_distance: d_t of Eq. 30, smoothing acts on cuts whose edge point lies
+        within d_t of the tip along the edge. Default 0.1.
+    edge_smoothing_distance: d_e of Eq. 30, smoothing acts within d_e of the edge point
+        along each cut. Default 0.05.
+    transition_s: s_j of Eq. 48, the point of c_LETE (fractional arclength from the
+        trailing edge at the hub) above which the curves are plain cuts; below, they come
+        from transfinite interpolation. Must exceed s_tip + d_t/L. Default 0.75 (about
+        half-way down the leading edge, Hally's advice).
+    filter_strength: α of Eq. 30 (0 < α <= 0.75, the stability limit of Eq. 29).
+        Default 0.5.
+    filter_iterations: n of Eq. 29. Default 50.
+    tolerance: the accuracy of the spline curves (§9). Default 2e-5 (= 1e-5 D).
+    sample_spacing: d of Eqs. 27–28, the largest spacing of the cut samples (§7).
+        Default 0.01.
+    edge_spacing_ratio: h/d of Eq. 28; Hally: h = d/100. Default 0.01.
+    defining_points: the six points of §4 (:class:`~.corners.DefiningPoints`).
+    """
+
+    delta_c: float = 0.02
+    tip_smoothing_distance: float = 0.1
+    edge_smoothing_distance: float = 0.05
+    transition_s: float = 0.75
+    filter_strength: float = 0.5
+    filter_iterations: int = 50
+    tolerance: float = 2e-5
+    sample_spacing: float = 0.01
+    edge_spacing_ratio: float = 0.01
+    defining_points: DefiningPoints = field(default_factory=DefiningPoints)
+
+    def __post_init__(self):
+        def num(name, lo=None, hi=None, lo_open=True, hi_open=False):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not np.isfinite(v):
+                raise DefinitionError(f"must be a finite number, got {v!r}", field=name)
+            if lo is not None and (v <= lo if lo_open else v < lo):
+                raise DefinitionError(f"must be {'>' if lo_open else '>='} {lo}, got {v}", field=name)
+            if hi is not None and (v >= hi if hi_open else v > hi):
+                raise DefinitionError(f"must be {'<' if hi_open else '<='} {hi}, got {v}", field=name)
+
+        num("delta_c", 0.0, 1.0)
+        num("tip_smoothing_distance", 0.0, 2.0)
+        num("edge_smoothing_distance", 0.0, 2.0)
+        num("transition_s", 0.0, 1.0, hi_open=True)
+        num("filter_strength", 0.0, MAX_STABLE_FILTER_STRENGTH, lo_open=False)
+        num("tolerance", 0.0, 0.01)
+        num("sample_spacing", 0.0, 1.0)
+        num("edge_spacing_ratio", 0.0, 1.0, hi_open=True)
+        it = self.filter_iterations
+        if isinstance(it, bool) or not isinstance(it, (int, np.integer)) or it < 0:
+            raise DefinitionError(f"must be an integer >= 0, got {it!r}", field="filter_iterations")
+        if not isinstance(self.defining_points, DefiningPoints):
+            raise DefinitionError("expected a DefiningPoints", field="defining_points")
+        self.defining_points.validate(field_prefix="defining_points.")
+
+    @classmethod
+    def field_names(cls) -> tuple[str, ...]:
+        return tuple(f.name for f in fields(cls))
+
+    #: Settings that are lengths (fractions of R here; metres in :meth:`from_metres`).
+    LENGTH_FIELDS = ("delta_c", "tip_smoothing_distance", "edge_smoothing_distance", "tolerance", "sample_spacing")
+
+    @classmethod
+    def from_metres(cls, values, radius: float) -> "SmoothingSettings":
+        """Settings from a mapping keyed like the fields whose lengths are in metres (the
+        operator's convention); missing keys keep their defaults. ``defining_points`` may
+        be a DefiningPoints or a mapping of its fields."""
+        kw = {}
+        for name in cls.field_names():
+            if name not in values:
+                continue
+            v = values[name]
+            if name in cls.LENGTH_FIELDS:
+                v = float(v) / radius
+            elif name == "defining_points" and not isinstance(v, DefiningPoints):
+                v = DefiningPoints(**dict(v))
+            kw[name] = v
+        return cls(**kw)
+
+
+class Overlays(dict):
+    """Display polylines (metres), computed when first asked for: 'cuts' (list of
+    (201, 3): the tip, leading-edge and trailing-edge curves), 'lete' (801, 3) and
+    'transition' (the 0-based index j of the transition cut)."""
+
+    def __init__(self, blade, curves):
+        super().__init__()
+        self._blade, self._curves = blade, curves
+
+    def __missing__(self, key):
+        c, b = self._curves, self._blade
+        if key == "cuts":
+            tt = np.linspace(0.0, 1.0, 201)
+            fam = c.tip + c.leading + c.trailing
+            X, _ = evaluate_curves(b, fam, tt)
+            value = list(X)
+        elif key == "lete":
+            value = c.lete.points(b, np.linspace(0.0, 1.0, 801))
+        elif key == "transition":
+            value = c.transition
+        else:
+            raise KeyError(key)
+        self[key] = value
+        return value
+
+
+@dataclass(frozen=True, eq=False)
+class SmoothedBlade:
+    """The result of :func:`smooth_blade`.
+
+    pressure_central, suction_central, leading_edge, trailing_edge, tip: the five
+    BSplineSurfaces (cubic, outward normals S_u × S_v). ``parameter_surfaces``: companion
+    surfaces of approximate blade parameters (for projections). ``curves``: the §8
+    EdgeCurveSet (c_LETE, cuts, families, transition index j). ``overlays``: polylines
+    (metres) for display: 'cuts' (list of (n, 3)), 'lete' (n, 3), 'transition' (index j,
+    0-based). ``report``: counts, knots, deviations, fallbacks, stage times."""
+
+    pressure_central: BSplineSurface
+    suction_central: BSplineSurface
+    leading_edge: BSplineSurface
+    trailing_edge: BSplineSurface
+    tip: BSplineSurface
+    parameter_surfaces: dict
+    curves: EdgeCurveSet
+    overlays: dict
+    report: dict
+    settings: SmoothingSettings
+
+    @property
+    def surfaces(self) -> tuple[BSplineSurface, ...]:
+        """The five surfaces in the order of SURFACE_NAMES."""
+        return tuple(getattr(self, n) for n in SURFACE_NAMES)
+
+    @property
+    def named_surfaces(self) -> dict[str, BSplineSurface]:
+        """The five surfaces by name (SURFACE_NAMES)."""
+        return {n: getattr(self, n) for n in SURFACE_NAMES}
+
+
+# shared edges: (surface a, side a, surface b, side b, reversed)
+SHARED_EDGES = (
+    ("pressure_central", "u1", "leading_edge", "u0", False),
+    ("pressure_central", "u0", "trailing_edge", "u1", False),
+    ("suction_central", "u0", "leading_edge", "u1", False),
+    ("suction_central", "u1", "trailing_edge", "u0", False),
+    ("pressure_central", "v1", "tip", "v0", False),
+    ("suction_central", "v1", "tip", "v1", True),
+    ("leading_edge", "v1", "tip", "u1", False),
+    ("trailing_edge", "v1", "tip", "u0", True),
+)
+
+
+def boundary_parameters(side: str, t) -> tuple[np.ndarray, np.ndarray]:
+    t = np.asarray(t, dtype=np.float64)
+    fixed = np.full_like(t, 0.0 if side.endswith("0") else 1.0)
+    return (fixed, t) if side.startswith("u") else (t, fixed)
+
+
+def shared_edge_report(surfaces: dict, samples: int = 200) -> list[dict]:
+    """For every shared edge: the largest distance between the two surfaces at
+    ``samples`` points, and the largest angle (degrees) between their normals away from
+    the tip surface's corners (``max_normal_angle_deg``; within TIP_CORNER_EXCLUSION of
+    them the tip surface's u and v directions are parallel, see the module docstring;
+    ``max_normal_angle_all_deg`` includes them)."""
+    t = np.linspace(0.0, 1.0, samples)
+    out = []
+    for a, sa, b, sb, rev in SHARED_EDGES:
+        ua, va = boundary_parameters(sa, t)
+        ub, vb = boundary_parameters(sb, t[::-1] if rev else t)
+        Xa, Xb = surfaces[a].evaluate(ua, va), surfaces[b].evaluate(ub, vb)
+        Na, Nb = surfaces[a].normal(ua, va), surfaces[b].normal(ub, vb)
+        ang = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", Na, Nb), -1.0, 1.0)))
+        keep = np.ones(samples, dtype=bool)
+        if b == "tip":
+            keep = (t >= TIP_CORNER_EXCLUSION) & (t <= 1.0 - TIP_CORNER_EXCLUSION)
+        out.append({"edge": f"{a}.{sa} / {b}.{sb}", "max_gap": float(np.max(np.linalg.norm(Xa - Xb, axis=1))),
+                    "max_normal_angle_deg": float(np.max(ang[keep])), "max_normal_angle_all_deg": float(np.max(ang)),
+                    "angles": ang})
+    return out
+
+
+def project_to_blade(blade, X, p_guess, iterations: int = PROJECTION_ITERATIONS):
+    """Closest points on b from starting parameters (Newton on |b(p) - x|², full Hessian
+    where it is positive definite, Gauss–Newton otherwise): (distances (n,), p (n, 2))."""
+    p = np.array(p_guess, dtype=np.float64)
+    for _ in range(iterations):
+        D = blade_derivatives(blade, p, 2)
+        r = D[:, 0, 0] - X
+        bx, be = D[:, 1, 0], D[:, 0, 1]
+        g = np.stack([np.einsum("ij,ij->i", bx, r), np.einsum("ij,ij->i", be, r)], axis=1)
+        a = np.einsum("ij,ij->i", bx, bx)
+        b = np.einsum("ij,ij->i", bx, be)
+        c = np.einsum("ij,ij->i", be, be)
+        ha = a + np.einsum("ij,ij->i", D[:, 2, 0], r)
+        hb = b + np.einsum("ij,ij->i", D[:, 1, 1], r)
+        hc = c + np.einsum("ij,ij->i", D[:, 0, 2], r)
+        det = ha * hc - hb * hb
+        use = (det > 0) & (ha > 0)
+        ha, hb, hc = np.where(use, ha, a), np.where(use, hb, b), np.where(use, hc, c)
+        det = ha * hc - hb * hb
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dx = np.where(det > 0, -(hc * g[:, 0] - hb * g[:, 1]) / det, 0.0)
+            de = np.where(det > 0, -(-hb * g[:, 0] + ha * g[:, 1]) / det, 0.0)
+        p[:, 0] += np.clip(dx, -0.05, 0.05)
+        p[:, 1] = np.clip(p[:, 1] + np.clip(de, -0.05, 0.05), blade.eta_min, 1.0)
+    dist = np.linalg.norm(blade_points(blade, p) - X, axis=1)
+    return dist, p
+
+
+def _zone_mask(smoothed: np.ndarray, coord: np.ndarray) -> np.ndarray:
+    """Samples whose across-curve coordinate lies within one curve spacing of a smoothed
+    curve (the smoothing zone)."""
+    idx = np.flatnonzero(smoothed)
+    if idx.size == 0:
+        return np.zeros(coord.shape, dtype=bool)
+    k = coord * (len(smoothed) - 1)
+    return (k >= idx.min() - 1) & (k <= idx.max() + 1)
+
+
+def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curves: EdgeCurveSet, samples: int = 41):
+    """Closest-point distance from the surfaces to the unsmoothed blade, split into the
+    smoothing zone and the rest (metres): dict per surface and overall maxima."""
+    t = np.linspace(0.0, 1.0, samples)
+    U, V = np.meshgrid(t, t, indexing="ij")
+    u, v = U.ravel(), V.ravel()
+    zone_coord = {"leading_edge": (curves.smoothed_leading, v), "trailing_edge": (curves.smoothed_trailing, v),
+                  "tip": (curves.smoothed_tip, u)}
+    out = {}
+    for name, S in smoothed_surfaces.items():
+        X = S.evaluate(u, v)
+        if name == "tip":
+            # the tip's parameters jump between ξ branches across the tip (no continuous
+            # companion): start from the nearest tip cut instead
+            k = np.rint(u * (len(curves.tip) - 1)).astype(int)
+            P = np.empty((u.size, 2))
+            for kk in np.unique(k):
+                P[k == kk] = curves.tip[kk].parameters(v[k == kk])
+        else:
+            P = param_surfaces[name].evaluate(u, v)
+        d, _ = project_to_blade(blade, X, P)
+        if name in zone_coord:
+            zone = _zone_mask(*zone_coord[name])
+        else:
+            zone = np.zeros(d.shape, dtype=bool)
+        out[name] = {"outside": float(d[~zone].max()) if np.any(~zone) else 0.0,
+                     "inside": float(d[zone].max()) if np.any(zone) else 0.0}
+    out["max_outside"] = max(v["outside"] for v in out.values() if isinstance(v, dict))
+    out["max_inside"] = max(v["inside"] for v in out.values() if isinstance(v, dict))
+    return out
+
+
+def tip_cut_fairness(blade, curves: EdgeCurveSet, tip_surface: BSplineSurface, samples: int = 801) -> list[dict]:
+    """Sign changes of the in-plane curvature (see
+    :func:`~.cut_smoothing.curvature_sign_changes`) along every tip cut: the unsmoothed
+    cut and the smoothed cut (each as its spline on the common knots of §9) and the tip
+    surface's iso-curve through it (Hally §7: smoothing must not add inflections)."""
+    U = tip_surface.knots_v
+    g = greville_abscissae(U, DEGREE)
+    plain = [replace(c.curve, offset=None) for c in curves.cuts["tip"]]
+    X0, _ = evaluate_curves(blade, plain, g)
+    X1, _ = evaluate_curves(blade, curves.tip, g)
+    R0, R1 = fit_rows(U, X0), fit_rows(U, X1)
+    t = np.linspace(0.0, 1.0, samples)
+    n_t = len(curves.tip)
+    out = []
+    for i, cut in enumerate(curves.cuts["tip"]):
+        n = cut.normal
+        k0 = spline_signed_curvature(BSplineCurve(DEGREE, U, R0[i]), t, n)
+        k1 = spline_signed_curvature(BSplineCurve(DEGREE, U, R1[i]), t, n)
+        k2 = spline_signed_curvature(tip_surface.iso_curve("u", i / (n_t - 1)), t, n)
+        out.append({"cut": i, "smoothed": bool(curves.smoothed_tip[i]),
+                    "sign_changes_unsmoothed": curvature_sign_changes(k0),
+                    "sign_changes_smoothed": curvature_sign_changes(k1),
+                    "sign_changes_surface": curvature_sign_changes(k2)})
+    return out
+
+
+def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None, measure: bool = True) -> SmoothedBlade:
+    """Hally (2013) §§3–9 for the reference blade of ``model`` (a PropellerModel).
+    ``settings``: SmoothingSettings (lengths as fractions of R) or a mapping with lengths
+    in metres (:meth:`SmoothingSettings.from_metres`, the operator's convention).
+    ``progress(stage, fraction)`` is called between stages. With ``measure`` the report
+    includes the deviation from the unsmoothed blade and the shared-edge checks."""
+    blade = model.blade
+    if settings is None:
+        settings = SmoothingSettings()
+    elif not isinstance(settings, SmoothingSettings):
+        settings = SmoothingSettings.from_metres(settings, blade.radius)
+    R = blade.radius
+    times = {}
+    clock = time.perf_counter()
+
+    def lap(name):
+        nonlocal clock
+        now = time.perf_counter()
+        times[name] = now - clock
+        clock = now
+        if progress:
+            progress(name, 1.0)
+
+    settings.defining_points.validate(blade, field_prefix="defining_points.")
+    corners = corner_points(blade, model.blade_hub_intersection, settings.defining_points)
+    check_corner_order(corners)
+    lap("corners")
+    sides = side_curves(blade, corners)
+    lap("side_curves")
+    curves = build_edge_curves(blade, corners, sides, settings)
+    lap("cuts_and_edge_curves")
+    tol = settings.tolerance * R
+    fam = {"leading_edge": curves.leading, "trailing_edge": curves.trailing, "tip": curves.tip}
+    # one knot sequence for every distinct curve (c_11, c_12 are shared by two families)
+    unique = curves.leading + curves.trailing[:-1] + curves.tip[1:-1]
+    knot_report: dict = {}
+    U, C, Pg = common_knots(blade, unique, tol, knot_report)
+    nL, nT = len(curves.leading), len(curves.trailing)
+    C_le, P_le = C[:nL], Pg[:nL]
+    te_rows, te_prows = C[nL : nL + nT - 1], Pg[nL : nL + nT - 1]
+    tip_rows, tip_prows = C[nL + nT - 1 :], Pg[nL + nT - 1 :]
+    # c_11 (the first tip cut, the top trailing-edge curve reversed): with the symmetric
+    # knots, reversing its fitted row gives the fit of the reversed curve
+    g = greville_abscissae(U, DEGREE)
+    X11, P11 = evaluate_curves(blade, [curves.tip[0]], g)
+    row_c11, prow_c11 = fit_rows(U, X11)[0], P11[0]
+    C_te = np.concatenate([te_rows, row_c11[None, ::-1]])
+    P_te = np.concatenate([te_prows, prow_c11[None, ::-1]])
+    # c_12 is the top leading-edge curve and the last tip cut (one object)
+    C_tip = np.concatenate([row_c11[None], tip_rows, C_le[-1:]])
+    P_tip = np.concatenate([prow_c11[None], tip_prows, P_le[-1:]])
+    lap("common_knots")
+    le = edge_surface(U, C_le, P_le)
+    te = edge_surface(U, C_te, P_te)
+    tip = edge_surface(U, C_tip, P_tip, along_u=False)
+    # central surfaces (§9 steps 3–5)
+    n_t, n_e = len(curves.tip), nL
+    _, V_t = across_knots(n_t)
+    _, V_e = across_knots(n_e)
+    ut, ue = curves.u_tip, curves.u_edge
+    e = curves.edges
+    pc = central_surface(
+        blade, e["c2"].parameters(ut), e["c9"].parameters(ut), e["c5"].parameters(ue), e["c6"].parameters(ue),
+        V_t, V_e,
+        {"u0": te.surface.control_points[-1], "u1": le.surface.control_points[0], "v1": tip.surface.control_points[:, 0]},
+    )
+    sc = central_surface(
+        blade, e["c4"].parameters(ut), e["c10"].parameters(ut), e["c7"].parameters(ue), e["c8"].parameters(ue) + np.array([1.0, 0.0]),
+        V_t, V_e,
+        {"u0": le.surface.control_points[-1], "u1": te.surface.control_points[0],
+         "v1": tip.surface.control_points[::-1, -1]},
+    )
+    pairs = {"pressure_central": pc, "suction_central": sc, "leading_edge": le, "trailing_edge": te, "tip": tip}
+    if blade.hand < 0:  # ξ in (0, 1/2) is the suction side of a left-handed blade
+        pairs["pressure_central"], pairs["suction_central"] = sc, pc
+    lap("surfaces")
+    surfaces = {k: v.surface for k, v in pairs.items()}
+    params = {k: v.parameters for k, v in pairs.items()}
+    _check_orientation(blade, pairs)
+    fallbacks = {"xi_search": 0, "bisection": 0}
+    all_cuts = list(curves.cuts["tip"]) + list(curves.cuts["leading"].values()) + list(curves.cuts["trailing"].values())
+    for c in all_cuts:
+        for k in fallbacks:
+            fallbacks[k] += c.fallbacks.get(k, 0)
+    overlays = Overlays(blade, curves)
+    report = {
+        "cuts": {"tip": len(curves.tip), "leading_edge": nL, "trailing_edge": nT, "planar": len(all_cuts),
+                 "smoothed": int(curves.smoothed_tip.sum() + curves.smoothed_leading[:-1].sum()
+                                 + curves.smoothed_trailing[:-1].sum())},
+        "transition_index": curves.transition,
+        "knots": knot_report,
+        "newton_fallbacks": fallbacks,
+        "tolerance_m": tol,
+        "max_smoothing_displacement_m": max([s.max_displacement for s in curves.smoothing.values()], default=0.0),
+        "times_s": times,
+    }
+    lap("report")
+    if measure:
+        dev = deviation_report(blade, surfaces, params, curves)
+        report["deviation_m"] = dev
+        report["deviation_bound_inside_m"] = SMOOTHING_ZONE_BOUND * R
+        report["shared_edges"] = [{k: v for k, v in e.items() if k != "angles"} for e in shared_edge_report(surfaces)]
+        lap("measure")
+    report["times_s"]["total"] = sum(v for k, v in times.items() if k != "total")
+    return SmoothedBlade(**surfaces, parameter_surfaces=params, curves=curves, overlays=overlays, report=report,
+                         settings=settings)
+
+
+def _check_orientation(blade, pairs: dict) -> None:
+    """S_u × S_v must point out of the blade on all five surfaces (Hally Eq. 1)."""
+    for name, pair in pairs.items():
+        u = np.array([0.3, 0.5, 0.7])
+        S, P = pair.surface, pair.parameters
+        n_s = S.normal(u, u)
+        n_b = blade.normal(P.evaluate(u, u)[:, 0], np.clip(P.evaluate(u, u)[:, 1], blade.eta_min, 1 - 1e-9))
+        if np.any(np.einsum("ij,ij->i", n_s, n_b) <= 0):
+            raise GeometryError(f"the {name} surface is not oriented outwards (internal error)")
