@@ -4,7 +4,7 @@ Submodules are listed in registration order; each exposes ``register``/``unregis
 """
 import importlib
 
-_SUBMODULES = ()
+_SUBMODULES = ("propeller_panel",)
 
 
 def _modules():
