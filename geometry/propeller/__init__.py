@@ -1,5 +1,6 @@
 """Propellers after Hally (2013): the blade b(ξ, η) from a table of sections, the hub,
-the blade–hub intersection, and tip smoothing into five spline surfaces (§§3–9)."""
+the blade–hub intersection, tip smoothing into five spline surfaces (§§3–9) and the
+trimmed hub sector (§10)."""
 from .blade import BladeSurface, SectionMeasurement
 from .definition import (
     HubDefinition,
@@ -10,6 +11,7 @@ from .definition import (
     read_radial_csv,
 )
 from .hub import Hub
+from .hub_sector import HubSector, hub_sector
 from .intersection import BladeHubIntersection, blade_hub_intersection, solve_intersection
 from .model import PropellerModel
 from .smoothing import SmoothedBlade, SmoothingSettings, smooth_blade
@@ -18,6 +20,7 @@ __all__ = [
     "BladeHubIntersection",
     "BladeSurface",
     "Hub",
+    "HubSector",
     "HubDefinition",
     "Propeller",
     "PropellerModel",
@@ -28,6 +31,7 @@ __all__ = [
     "SmoothingSettings",
     "blade_hub_intersection",
     "dumps_toml",
+    "hub_sector",
     "read_radial_csv",
     "smooth_blade",
     "solve_intersection",

@@ -1,0 +1,189 @@
+"""The propeller as IGES records (Hally 2013 §11): the reference blade's surfaces and its
+trimmed hub sector.
+
+Entities (IGES 5.3 §4):
+
+* each blade surface as a Rational B-Spline Surface (128). Hally writes C2 surfaces as 128
+  and the others as Parametric Spline Surfaces (114); a 128 represents every B-spline
+  surface exactly whatever its continuity, and the surfaces of the smoothing pipeline are
+  C2 cubics anyway (:func:`surface_continuity` reports it), so 128 is always written.
+* the hub as a Surface of Revolution (120): the spine as an exact rational quadratic
+  B-spline (126) with simple knots (:func:`~bladesmith.geometry.propeller.hub_sector.c1_spine`,
+  C1 as a B-spline, so readers see a C1 surface; Hally writes 126 when the spine is C2,
+  else 112 — a 126 is exact for any spline), laid in the plane x = 0 as (0, ρ, z) and
+  turned about the axis Line (110) from (0, 0, 0) to (0, 0, -1) (θ is a right-hand
+  rotation about -z, see
+  :mod:`bladesmith.geometry.propeller.hub`), over the sector's angular range (inside
+  [-π, π], narrower than 2π so the 120 stays an open surface). Its parameter space
+  (u = spine parameter s, v = angle) is the hub parameter space (ξ, θ) of Hally §10.
+* the sector as a Trimmed Surface (144) over the 120 with
+  - an outer Curve on a Parametric Surface (142) whose parameter-space curve is a
+    Composite Curve (102) of the two sector edges (126, cubic, exact) and the two end
+    lines (110), counter-clockwise in (u, v);
+  - one inner 142 along the blade footprint (a closed cubic 126), clockwise.
+  The 142s carry the parameter-space curve only (PREF = 1, S∘B preferred): the end lines
+  lie on the poles of the hub, whose model-space images are points that no 110 or 126 can
+  hold, and OpenCASCADE builds the edges from S∘B (3-D curves by BRepLib) without a
+  message. ``model_curves=True`` adds 3-D approximations (a composite of the two sector
+  edges, which meet at the poles, and the footprint) with PREF = 3.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..geometry.errors import GeometryError, IgesError
+from ..geometry.nurbs import BSplineSurface
+from .convert import curve_from_geometry, surface_from_geometry
+from .records import UNITS, CompositeCurve, CurveOnSurface, Line, SurfaceOfRevolution, TrimmedSurface
+from .writer import DEFAULT_RESOLUTION, write_iges
+
+#: The five blade surfaces of Hally (2013) §4 / Fig. 2, in the order written, with labels.
+BLADE_SURFACES = (
+    ("pressure_central", "PRESSURE"),
+    ("suction_central", "SUCTION"),
+    ("leading_edge", "LEADEDGE"),
+    ("trailing_edge", "TRAILEDG"),
+    ("tip", "TIP"),
+)
+HUB_LABEL = "HUB"
+#: Metres per file unit for the unit names ``write_iges`` accepts.
+METRES_PER_UNIT = {
+    "in": 0.0254, "inch": 0.0254, "mm": 1e-3, "ft": 0.3048, "mi": 1609.344, "m": 1.0, "km": 1e3,
+    "mil": 2.54e-5, "um": 1e-6, "cm": 1e-2, "uin": 2.54e-8,
+}
+#: A blade surface's boundary is "on the hub" when it comes this close to it, as a fraction
+#: of the diameter (only used to refuse blade surfaces that do not belong to this hub).
+ROOT_CHECK_FRACTION = 1e-2
+
+
+def surface_continuity(surface: BSplineSurface) -> int:
+    """The parametric continuity C^k of a B-spline surface at its interior knots
+    (k = degree - the largest interior multiplicity, the lesser of the two directions)."""
+    ks = []
+    for p, U in ((surface.degree_u, surface.knots_u), (surface.degree_v, surface.knots_v)):
+        inner = U[p + 1 : U.size - p - 1]
+        mult = max((int(np.sum(inner == k)) for k in np.unique(inner)), default=0)
+        ks.append(p - mult if mult else p + 100)
+    return min(ks)
+
+
+def _blade_surfaces(blade) -> list[tuple[str, BSplineSurface]]:
+    """(label, surface) for a SmoothedBlade-like object, a mapping, or a sequence."""
+    if isinstance(blade, BSplineSurface):
+        blade = [blade]
+    if isinstance(blade, dict):
+        items = [(label, blade[name]) for name, label in BLADE_SURFACES if name in blade]
+        extra = set(blade) - {n for n, _ in BLADE_SURFACES}
+        if extra:
+            raise GeometryError(f"unknown blade surface names {sorted(extra)}; expected "
+                                f"{[n for n, _ in BLADE_SURFACES]}")
+    elif all(hasattr(blade, name) for name, _ in BLADE_SURFACES):
+        items = [(label, getattr(blade, name)) for name, label in BLADE_SURFACES]
+    else:
+        try:
+            seq = list(blade)
+        except TypeError:
+            raise GeometryError(f"blade surfaces: expected a SmoothedBlade, a dict or a sequence of "
+                                f"BSplineSurface, got {type(blade).__name__}") from None
+        items = [(f"BLADE{i + 1}", s) for i, s in enumerate(seq)]
+    if not items:
+        raise GeometryError("no blade surfaces given")
+    for label, s in items:
+        if not isinstance(s, BSplineSurface):
+            raise GeometryError(f"blade surface {label}: expected a BSplineSurface, got {type(s).__name__}")
+        if s.dim != 3:
+            raise GeometryError(f"blade surface {label}: expected 3-D control points, got dimension {s.dim}")
+        if not np.all(np.isfinite(s.control_points)):
+            raise GeometryError(f"blade surface {label}: control points are not finite")
+    return items
+
+
+def _check_consistency(model, blade_items, sector) -> None:
+    """Refuse data that cannot belong together (before any record is made)."""
+    if sector.hub is not model.hub:
+        raise GeometryError("the hub sector was built for a different propeller model")
+    if sector.blades != model.blades:
+        raise GeometryError(f"the hub sector is for {sector.blades} blades, the model has {model.blades}")
+    a0, a1 = sector.angle_range
+    for loop in sector.loops:
+        for c in loop:
+            P = c.control_points
+            if P.shape[1] != 2:
+                raise GeometryError("hub sector loops must be 2-D curves in (ξ_h, θ)")
+            if (P[:, 0].min() < sector.xi_lo - 1e-12 or P[:, 0].max() > sector.xi_hi + 1e-12
+                    or P[:, 1].min() < a0 - 1e-12 or P[:, 1].max() > a1 + 1e-12):
+                raise GeometryError("a hub sector loop leaves the hub's parameter range")
+    D = 2.0 * float(model.blade.radius)
+    R_hub = float(model.hub.radius)
+    reach = ROOT_CHECK_FRACTION * D
+    for label, s in blade_items:
+        r = np.hypot(s.control_points[..., 0], s.control_points[..., 1])
+        if r.max() < R_hub - reach or r.max() > 0.5 * D * (1.0 + ROOT_CHECK_FRACTION):
+            raise GeometryError(f"blade surface {label} does not lie between the hub (r = {R_hub:.6g} m) "
+                                f"and the tip (r = {0.5 * D:.6g} m) of this propeller")
+
+
+def hub_records(sector, *, scale: float = 1.0, model_curves: bool = False) -> TrimmedSurface:
+    """The hub sector as a 144 over a 120 (see the module docstring); 3-D coordinates times
+    ``scale`` (file units per metre); parameter-space curves are in (ξ_h, θ) as they are."""
+    axis = Line(start=[0.0, 0.0, 0.0], end=[0.0, 0.0, -1.0])
+    spine = curve_from_geometry(sector.generatrix, scale=scale, label="SPINE")
+    a0, a1 = map(float, sector.angle_range)
+    surface = SurfaceOfRevolution(axis=axis, generatrix=spine, start_angle=a0, end_angle=a1)
+
+    pieces = []
+    for c in sector.outer_loop:
+        if c.degree == 1 and c.n_control == 2:
+            pieces.append(Line(start=c.control_points[0], end=c.control_points[1]))
+        else:
+            pieces.append(curve_from_geometry(c))
+    outer_param = CompositeCurve(curves=pieces)
+    inner_param = curve_from_geometry(sector.footprint)
+    outer_model = inner_model = None
+    pref = 1
+    if model_curves:
+        outer3, inner3 = sector.model_loops()
+        outer_model = CompositeCurve(curves=[curve_from_geometry(c, scale=scale) for c in outer3])
+        inner_model = curve_from_geometry(inner3[0], scale=scale)
+        pref = 3
+    outer = CurveOnSurface(surface=surface, parameter_curve=outer_param, model_curve=outer_model,
+                           creation=0, preferred=pref)
+    inner = CurveOnSurface(surface=surface, parameter_curve=inner_param, model_curve=inner_model,
+                           creation=2, preferred=pref)
+    return TrimmedSurface(surface=surface, outer=outer, inner=(inner,), label=HUB_LABEL)
+
+
+def propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, model_curves: bool = False) -> list:
+    """IGES records of the reference blade and its trimmed hub sector (Hally 2013 §11).
+
+    model: the :class:`~bladesmith.geometry.propeller.PropellerModel`. blade: a
+    ``SmoothedBlade`` (attributes pressure_central, suction_central, leading_edge,
+    trailing_edge, tip), a dict with those keys, or a sequence of BSplineSurface.
+    hub_sector: the :class:`~bladesmith.geometry.propeller.hub_sector.HubSector` of
+    ``model``. units: the file's length unit; geometry (metres) is scaled to it.
+    Returns the root records: one 128 per blade surface, then the 144.
+    Raises GeometryError/IgesError for inconsistent data.
+    """
+    key = units.lower() if isinstance(units, str) else units
+    if key not in UNITS or key not in METRES_PER_UNIT:
+        raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}")
+    scale = 1.0 / METRES_PER_UNIT[key]
+    items = _blade_surfaces(blade)
+    _check_consistency(model, items, hub_sector)
+    records = [surface_from_geometry(s, scale=scale, label=label) for label, s in items]
+    records.append(hub_records(hub_sector, scale=scale, model_curves=model_curves))
+    return records
+
+
+def write_propeller_iges(path, model, blade, hub_sector, units: str = "m", *, resolution: float | None = None,
+                         model_curves: bool = False, **options) -> str:
+    """Write the propeller's reference blade and hub sector to ``path`` (atomically, via
+    :func:`bladesmith.iges.write_iges`, which validates every record first). resolution:
+    Global field 19 in file units (default DEFAULT_RESOLUTION metres converted). Returns
+    the path."""
+    records = propeller_iges_entities(model, blade, hub_sector, units, model_curves=model_curves)
+    if resolution is None:
+        resolution = DEFAULT_RESOLUTION / METRES_PER_UNIT[units.lower()]
+    return write_iges(os.fspath(path), records, units=units, resolution=resolution, **options)
