@@ -11,7 +11,7 @@ from .definition import (
     read_radial_csv,
 )
 from .hub import Hub
-from .hub_sector import HubSector, hub_sector
+from .hub_sector import HubSector
 from .intersection import BladeHubIntersection, blade_hub_intersection, solve_intersection
 from .model import PropellerModel
 from .smoothing import SmoothedBlade, SmoothingSettings, smooth_blade
@@ -31,7 +31,6 @@ __all__ = [
     "SmoothingSettings",
     "blade_hub_intersection",
     "dumps_toml",
-    "hub_sector",
     "read_radial_csv",
     "smooth_blade",
     "solve_intersection",
