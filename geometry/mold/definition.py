@@ -1,0 +1,219 @@
+"""Wind-turbine blade definition files (TOML, metres) for the mold-halves pipeline.
+
+Format (every array of ``[stations]`` has one value per station, root to tip)::
+
+    name = "NREL 5-MW"
+    hub_radius = 1.5
+    mold_direction = [0.0, 1.0, 0.0]   # optional; the parting direction, default flapwise (+y)
+    wrap = true                        # optional; Hosseini Eq. 5 cylinder wrap, false = flat sections
+    first_aerodynamic_station = 4      # optional; stations before it form the root transition (§5.1)
+    control_points = 14                # optional; per half and section, raised until the tolerance holds
+    tolerance = 1e-4                   # optional; fraction of the local chord
+
+    [stations]
+    r = [...]           # m, strictly increasing
+    chord = [...]       # m, > 0
+    twist_deg = [...]
+    pitch_axis = [...]  # chord fraction from the LE
+    prebend = [...]     # optional, m (flapwise offset)
+    sweep = [...]       # optional, m (edgewise offset)
+    airfoil = [...]     # a .dat path (relative to the TOML file) or a shipped name, or "circle"
+
+Errors are :class:`DefinitionError` naming the file, the field and the station.
+"""
+from __future__ import annotations
+
+import math
+import pathlib
+import tomllib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import BladesmithError, DefinitionError
+from ..sections.airfoil_file import Airfoil, read_airfoil
+
+#: Points per half of the built-in "circle" section (cosine spaced, dense at the ends).
+CIRCLE_POINTS = 101
+
+#: Default control points per half and section (raised until the tolerance holds).
+DEFAULT_CONTROL_POINTS = 12
+
+#: Default fitting tolerance as a fraction of the local chord (issue 7).
+DEFAULT_TOLERANCE = 1e-4
+
+DATA_DIR = pathlib.Path(__file__).resolve().parent.parent.parent / "data"
+BLADES_DIR = DATA_DIR / "blades"
+
+REQUIRED = ("r", "chord", "twist_deg", "pitch_axis", "airfoil")
+OPTIONAL = ("prebend", "sweep")
+
+
+def circle_airfoil() -> Airfoil:
+    """A unit-diameter circle as an airfoil (LE at (0, 0), TE at (1, 0)): the blade root."""
+    th = np.pi * (1.0 - np.cos(np.linspace(0.0, np.pi, CIRCLE_POINTS))) / 2.0  # 0..π
+    x = 0.5 - 0.5 * np.cos(th)
+    y = 0.5 * np.sin(th)
+    upper = np.column_stack([x, y])
+    lower = np.column_stack([x, -y])
+    upper[-1, 1] = lower[-1, 1] = 0.0
+    return Airfoil("circle", upper, lower, "builtin", "")
+
+
+def shipped_airfoils() -> dict[str, pathlib.Path]:
+    """Names of the airfoils shipped in data/blades/airfoils and data/airfoils."""
+    out = {}
+    for folder in (DATA_DIR / "airfoils", BLADES_DIR / "airfoils"):
+        if folder.is_dir():
+            out.update({p.stem: p for p in sorted(folder.glob("*.dat"))})
+    return out
+
+
+def resolve_airfoil(spec: str, base: pathlib.Path | None) -> Airfoil:
+    """An airfoil from a station's ``airfoil`` entry: "circle", a shipped name, or a path."""
+    if spec == "circle":
+        return circle_airfoil()
+    shipped = shipped_airfoils()
+    if spec in shipped:
+        return read_airfoil(shipped[spec])
+    path = pathlib.Path(spec)
+    if not path.is_absolute() and base is not None:
+        path = base / path
+    return read_airfoil(path)
+
+
+@dataclass(frozen=True, eq=False)
+class Station:
+    r: float
+    chord: float
+    twist_deg: float
+    pitch_axis: float
+    airfoil: Airfoil
+    prebend: float = 0.0
+    sweep: float = 0.0
+    airfoil_name: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class BladeDefinition:
+    """A validated blade: stations root to tip, with their airfoils read."""
+
+    name: str
+    hub_radius: float
+    stations: tuple
+    mold_direction: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0, 0.0]))
+    wrap: bool = True
+    first_aerodynamic_station: int = 0
+    control_points: int = DEFAULT_CONTROL_POINTS
+    tolerance: float = DEFAULT_TOLERANCE
+    path: str = ""
+
+    def to_dict(self) -> dict:
+        """The definition as TOML-ready values (airfoils by name or path)."""
+        st = self.stations
+        return {
+            "name": self.name, "hub_radius": self.hub_radius, "mold_direction": self.mold_direction.tolist(),
+            "wrap": self.wrap, "first_aerodynamic_station": self.first_aerodynamic_station,
+            "control_points": self.control_points, "tolerance": self.tolerance,
+            "stations": {
+                "r": [s.r for s in st], "chord": [s.chord for s in st], "twist_deg": [s.twist_deg for s in st],
+                "pitch_axis": [s.pitch_axis for s in st], "prebend": [s.prebend for s in st],
+                "sweep": [s.sweep for s in st], "airfoil": [s.airfoil_name for s in st],
+            },
+        }
+
+
+def _number(value, path, fld) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise DefinitionError(f"expected a finite number, got {value!r}", path=path, field=fld)
+    return float(value)
+
+
+def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None) -> BladeDefinition:
+    """Validate a parsed definition. Bad stations are refused with the station named."""
+    if not isinstance(data, dict):
+        raise DefinitionError("expected a table", path=path)
+    name = str(data.get("name", pathlib.Path(path).stem if path else "blade"))
+    hub = _number(data.get("hub_radius", 0.0), path, "hub_radius")
+    st = data.get("stations")
+    if not isinstance(st, dict):
+        raise DefinitionError("missing [stations] table", path=path, field="stations")
+    for key in REQUIRED:
+        if key not in st:
+            raise DefinitionError("missing array", path=path, field=f"stations.{key}")
+    count = len(st["r"]) if isinstance(st["r"], list) else -1
+    if count < 2:
+        raise DefinitionError(f"expected an array of at least 2 stations, got {st['r']!r}", path=path, field="stations.r")
+    for key in REQUIRED + OPTIONAL:
+        if key in st and (not isinstance(st[key], list) or len(st[key]) != count):
+            raise DefinitionError(f"expected {count} values (one per station)", path=path, field=f"stations.{key}")
+    stations = []
+    for k in range(count):
+        vals = {key: _number(st[key][k], path, f"stations.{key}[{k}]") for key in REQUIRED[:-1]}
+        extra = {key: _number(st[key][k], path, f"stations.{key}[{k}]") for key in OPTIONAL if key in st}
+        if k and vals["r"] <= stations[-1].r:
+            raise DefinitionError(
+                f"station {k}: r = {vals['r']!r} m does not increase (station {k - 1} has r = {stations[-1].r!r} m)",
+                path=path, field=f"stations.r[{k}]")
+        if vals["r"] <= 0:
+            raise DefinitionError(f"station {k}: r must be > 0, got {vals['r']!r}", path=path, field=f"stations.r[{k}]")
+        if vals["chord"] <= 0:
+            raise DefinitionError(f"station {k}: chord must be > 0, got {vals['chord']!r}", path=path,
+                                  field=f"stations.chord[{k}]")
+        spec = st["airfoil"][k]
+        if not isinstance(spec, str) or not spec:
+            raise DefinitionError(f"station {k}: expected an airfoil name or path, got {spec!r}", path=path,
+                                  field=f"stations.airfoil[{k}]")
+        try:
+            foil = resolve_airfoil(spec, base)
+        except BladesmithError as exc:
+            raise DefinitionError(f"station {k}: cannot read airfoil {spec!r}: {exc}", path=path,
+                                  field=f"stations.airfoil[{k}]") from None
+        stations.append(Station(vals["r"], vals["chord"], vals["twist_deg"], vals["pitch_axis"], foil,
+                                extra.get("prebend", 0.0), extra.get("sweep", 0.0), spec))
+    direction = data.get("mold_direction", [0.0, 1.0, 0.0])
+    if not isinstance(direction, list) or len(direction) != 3:
+        raise DefinitionError(f"expected [x, y, z], got {direction!r}", path=path, field="mold_direction")
+    d = np.array([_number(v, path, "mold_direction") for v in direction])
+    if np.linalg.norm(d) == 0:
+        raise DefinitionError("the mold direction is the zero vector", path=path, field="mold_direction")
+    first = data.get("first_aerodynamic_station", 0)
+    if isinstance(first, bool) or not isinstance(first, int) or not 0 <= first <= count - 2:
+        raise DefinitionError(f"expected an integer in [0, {count - 2}], got {first!r}", path=path,
+                              field="first_aerodynamic_station")
+    n = data.get("control_points", DEFAULT_CONTROL_POINTS)
+    if isinstance(n, bool) or not isinstance(n, int) or n < 5:
+        raise DefinitionError(f"expected an integer >= 5, got {n!r}", path=path, field="control_points")
+    tol = _number(data.get("tolerance", DEFAULT_TOLERANCE), path, "tolerance")
+    if tol <= 0:
+        raise DefinitionError(f"expected a positive chord fraction, got {tol!r}", path=path, field="tolerance")
+    wrap = data.get("wrap", True)
+    if not isinstance(wrap, bool):
+        raise DefinitionError(f"expected true or false, got {wrap!r}", path=path, field="wrap")
+    return BladeDefinition(name, hub, tuple(stations), d / np.linalg.norm(d), wrap, first, n, tol, path)
+
+
+def load_blade(path) -> BladeDefinition:
+    """Read and validate a blade definition TOML file."""
+    path = pathlib.Path(path)
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except FileNotFoundError:
+        raise DefinitionError("definition file not found", path=str(path)) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise DefinitionError(f"not valid TOML ({exc})", path=str(path)) from None
+    return blade_from_dict(data, str(path), path.parent)
+
+
+def preset_files() -> dict[str, pathlib.Path]:
+    """Shipped blade definitions by preset name (file stem upper-cased: "NREL5MW")."""
+    return {p.stem.upper(): p for p in sorted(BLADES_DIR.glob("*.toml"))}
+
+
+def load_preset(name: str) -> BladeDefinition:
+    presets = preset_files()
+    key = name.upper()
+    if key not in presets:
+        raise DefinitionError(f"unknown blade preset {name!r}; shipped: {sorted(presets)}", field="preset")
+    return load_blade(presets[key])

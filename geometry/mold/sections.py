@@ -1,0 +1,303 @@
+"""Blade sections for mold design: 2-D airfoil to 3-D (Hosseini & Moetakef-Imani 2016,
+§4 Eq. 5), the silhouette point S, and the two-part constrained fit with G1 at S.
+
+Coordinates: x edgewise (tangential, the direction of rotation), y flapwise (the rotor
+axis; the default mold direction), z along the span. A wrapped section lies on the
+cylinder x² + z² = r² (Hosseini Fig. 4); a flat one in the plane z = r.
+
+The two-part fit follows Hosseini §4: the section is split at S, where its tangent is
+parallel to the mold direction; each half is a least-squares B-spline with its end point
+and end derivative prescribed (Piegl & Tiller 2000; The NURBS Book 2e §9.4.1–9.4.2), the
+derivative at S sharing one direction between the halves (G1) and its magnitude chosen by
+SQP (``scipy.optimize.minimize(method="SLSQP")``) minimising the least-squares error
+Eq. 3. The trailing edge is C0 (both ends interpolated), blunt or sharp.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq, minimize
+
+from ..errors import GeometryError
+from ..nurbs import BSplineCurve, fit_least_squares, interpolate, parameterize
+from ..nurbs.fitting import approximation_knots
+
+#: Default degree of the section curves (cubic, as in Hosseini §2).
+SECTION_DEGREE = 3
+
+#: S is sought only where the section is within this chord fraction of the leading edge
+#: (the leading-edge region of Hosseini Fig. 6b); elsewhere a tangent parallel to the mold
+#: direction (e.g. a vertical blunt trailing edge) is not the LE parting line.
+LE_REGION = 0.3
+
+#: A mold direction whose component across the span is shorter than this (unit vector)
+#: gives no silhouette: it is (nearly) parallel to the span axis.
+DIRECTION_TOL = 1e-6
+
+#: Data points closer to S than this fraction of the chord are dropped from the halves
+#: (S is interpolated; a data point on top of it would repeat a parameter).
+SPLIT_GAP = 1e-9
+
+#: Lower bound of the tangent magnitude at S, as a fraction of the initial estimate, so
+#: that SLSQP never proposes a cusp (zero derivative).
+MIN_MAGNITUDE_FRACTION = 1e-3
+
+#: The blade's span (pitch) axis.
+SPAN_AXIS = np.array([0.0, 0.0, 1.0])
+
+#: SLSQP stopping tolerance on the (chord-normalised) objective.
+SLSQP_FTOL = 1e-14
+
+
+# ---------------------------------------------------------------------------------------
+# 2-D -> 3-D (Eq. 5)
+# ---------------------------------------------------------------------------------------
+def section_points(xy, r: float, chord: float, twist_deg: float, pitch_axis: float = 0.25,
+                   prebend: float = 0.0, sweep: float = 0.0, wrap: bool = True) -> np.ndarray:
+    """3-D section points from unit-chord airfoil points (Hosseini 2016, §4 Eq. 5).
+
+    xy: (N, 2) unit chord, leading edge at the origin. The chord is scaled by c_i about the
+    pitch axis (chord fraction ``pitch_axis`` from the LE), rotated by the twist Tw_i
+    (R, θ of Eq. 5: (x', y') -> R(cos(θ+Tw), sin(θ+Tw))), offset by ``sweep`` (edgewise)
+    and ``prebend`` (flapwise), and wrapped onto the cylinder of radius r_i:
+    Q = (r sin(α/r), y, r cos(α/r)) with α = R cos(θ + Tw), an arc length (Eq. 5 writes
+    sin(α); the angle is α/r, as in Pérez-Arribas & Trejo-Vargas 2012, so the wrap is an
+    isometry). ``wrap=False`` gives the flat section Q = (α, y, r). Returns (N, 3).
+    """
+    P = np.asarray(xy, dtype=np.float64)
+    xp = chord * (P[:, 0] - pitch_axis)
+    yp = chord * P[:, 1]
+    tw = np.radians(twist_deg)
+    c, s = np.cos(tw), np.sin(tw)
+    alpha = c * xp - s * yp + sweep
+    y = s * xp + c * yp + prebend
+    if not wrap:
+        return np.column_stack([alpha, y, np.full_like(alpha, r)])
+    phi = alpha / r
+    return np.column_stack([r * np.sin(phi), y, r * np.cos(phi)])
+
+
+def radial_directions(points, wrap: bool) -> np.ndarray:
+    """Unit normals of the section's carrier surface (cylinder or plane z = r) at points."""
+    P = np.asarray(points, dtype=np.float64)
+    if not wrap:
+        return np.broadcast_to(np.array([0.0, 0.0, 1.0]), P.shape)
+    n = np.stack([P[..., 0], np.zeros(P.shape[:-1]), P[..., 2]], axis=-1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+# ---------------------------------------------------------------------------------------
+# silhouette point S
+# ---------------------------------------------------------------------------------------
+def silhouette_function(curve: BSplineCurve, u, direction, wrap: bool) -> np.ndarray:
+    """f(u) = det[C'(u), d, n(u)]: zero where the section tangent is parallel to the mold
+    direction d within the carrier surface (normal n): the tangent vertical of Hosseini
+    Fig. 6b. For the flat section and d in its plane it is C'_x d_y - C'_y d_x."""
+    D = curve.derivatives(np.asarray(u, dtype=np.float64), 1)
+    n = radial_directions(D[..., 0, :], wrap)
+    return np.einsum("...i,...i->...", np.cross(D[..., 1, :], np.broadcast_to(direction, n.shape)), n)
+
+
+def find_silhouette(curve: BSplineCurve, params, chordwise, direction, wrap: bool) -> float:
+    """Parameter of S on the fitted section ``curve`` (Hosseini §4, Fig. 6b).
+
+    params: data parameters; chordwise: chord fraction x of each data point (unit chord).
+    The sign changes of :func:`silhouette_function` at the data parameters inside the
+    leading-edge region (x < :data:`LE_REGION`) bracket the roots; the one nearest the
+    leading edge (smallest x) is refined with ``brentq`` on the curve itself, not on the
+    raw points. Raises GeometryError when there is none.
+    """
+    d = np.asarray(direction, dtype=np.float64)
+    if np.linalg.norm(np.cross(d, SPAN_AXIS)) < DIRECTION_TOL * np.linalg.norm(d):
+        raise GeometryError("the mold direction gives no silhouette point: it is (nearly) along the span axis")
+    f = silhouette_function(curve, params, d, wrap)
+    x = np.asarray(chordwise)
+    change = np.flatnonzero((np.sign(f[:-1]) != np.sign(f[1:])) & (np.minimum(x[:-1], x[1:]) < LE_REGION))
+    exact = np.flatnonzero((f == 0) & (x < LE_REGION))
+    if exact.size:
+        return float(params[exact[np.argmin(x[exact])]])
+    if not change.size:
+        raise GeometryError("the mold direction gives no silhouette point in the leading-edge region")
+    k = change[np.argmin(np.minimum(x[change], x[change + 1]))]
+    return float(brentq(lambda t: float(silhouette_function(curve, np.array([t]), d, wrap)[0]),
+                        params[k], params[k + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))
+
+
+# ---------------------------------------------------------------------------------------
+# the split
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class SplitSection:
+    """A section split at S.
+
+    points: (N, 3) the section data (trailing edge upper -> LE -> trailing edge lower).
+    upper: (nu, 3) from the upper TE point to S (S last); lower: (nl, 3) from S (first)
+    to the lower TE point. upper_data / lower_data: index arrays of the data points in
+    each half (S excluded). tangent: unit C'(u_S) of the preliminary fit, pointing from
+    the upper half into the lower one. magnitude_upper / magnitude_lower: |C'| at S scaled
+    to each half's [0, 1] parameter: the initial tangent magnitudes. chord: local chord.
+    """
+
+    points: np.ndarray
+    upper: np.ndarray
+    lower: np.ndarray
+    upper_data: np.ndarray
+    lower_data: np.ndarray
+    silhouette: np.ndarray
+    tangent: np.ndarray
+    magnitude_upper: float
+    magnitude_lower: float
+    chord: float
+
+
+def split_section(points, chordwise, chord: float, direction=(0.0, 1.0, 0.0), wrap: bool = True,
+                  degree: int = SECTION_DEGREE) -> SplitSection:
+    """Fit the whole section (interpolation, chord-length parameters, NURBS Book Alg. A9.1),
+    find S on it and split the data there (Hosseini §4)."""
+    Q = np.asarray(points, dtype=np.float64)
+    d = np.asarray(direction, dtype=np.float64)
+    t = parameterize(Q)
+    prelim = interpolate(Q, degree, params=t)
+    uS = find_silhouette(prelim, t, chordwise, d, wrap)
+    D = prelim.derivatives(np.array([uS]), 1)[0]
+    S, dS = D[0], D[1]
+    gap = SPLIT_GAP * chord
+    up = np.flatnonzero((t < uS) & (np.linalg.norm(Q - S, axis=1) > gap))
+    lo = np.flatnonzero((t > uS) & (np.linalg.norm(Q - S, axis=1) > gap))
+    speed = float(np.linalg.norm(dS))
+    return SplitSection(
+        points=Q, upper=np.vstack([Q[up], S]), lower=np.vstack([S, Q[lo]]), upper_data=up, lower_data=lo,
+        silhouette=S, tangent=dS / speed, magnitude_upper=speed * uS, magnitude_lower=speed * (1.0 - uS), chord=chord,
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# constrained fits (Piegl & Tiller 2000) with the SQP magnitude
+# ---------------------------------------------------------------------------------------
+def _residual(curve: BSplineCurve, points, params) -> np.ndarray:
+    return np.asarray(points) - curve.evaluate(params)
+
+
+class _AffineHalf:
+    """One half fitted with its end derivative λ·t at S: the least-squares control points
+    are affine in λ (the prescribed control point P_1 or P_{n-1} of Piegl & Tiller 2000
+    enters the right-hand side linearly), so the residual is r(λ) = r0 + λ g and two fits
+    give the objective Σ|Q_r - C(t_r)|² (Hosseini Eq. 3) exactly as a quadratic in λ."""
+
+    def __init__(self, points, knots, degree, tangent, at_start: bool):
+        self.points = points
+        self.params = parameterize(points)
+        self.knots = knots
+        self.degree = degree
+        self.tangent = tangent
+        self.at_start = at_start
+        r0 = self._fit(0.0)
+        r1 = self._fit(1.0)
+        self.r0 = _residual(r0, points, self.params).ravel()
+        self.g = _residual(r1, points, self.params).ravel() - self.r0
+
+    def _fit(self, magnitude: float) -> BSplineCurve:
+        D = magnitude * self.tangent
+        n_control = len(self.knots) - self.degree - 1
+        return fit_least_squares(
+            self.points, n_control, self.degree, params=self.params, knots=self.knots,
+            start_derivative=D if self.at_start else None, end_derivative=None if self.at_start else D,
+        )
+
+    def error(self, magnitude):
+        r = self.r0 + magnitude * self.g
+        return float(r @ r)
+
+    def gradient(self, magnitude):
+        return float(2.0 * (self.g @ (self.r0 + magnitude * self.g)))
+
+    def best(self) -> float:
+        """The unconstrained minimiser -(r0·g)/(g·g): a check on SLSQP."""
+        return float(-(self.r0 @ self.g) / (self.g @ self.g))
+
+
+@dataclass(frozen=True, eq=False)
+class TwoPartFit:
+    """Upper and lower section curves meeting at S with G1 (Hosseini §4).
+
+    upper: TE(upper) -> S, with C'(1) = magnitude_upper · tangent; lower: S -> TE(lower),
+    with C'(0) = magnitude_lower · tangent. lsq_error: Σ|Q_r - C(t_r)|² over both halves'
+    data points (Eq. 3, S excluded); max_residual: largest |Q_r - C(t_r)|.
+    """
+
+    upper: BSplineCurve
+    lower: BSplineCurve
+    magnitude_upper: float
+    magnitude_lower: float
+    lsq_error: float
+    max_residual: float
+    slsqp_iterations: int
+
+
+def default_knots(points, n_control: int, degree: int = SECTION_DEGREE) -> np.ndarray:
+    """Chord-length parameters and approximation knots (NURBS Book Eqs. 9.5, 9.68–9.69)."""
+    return approximation_knots(parameterize(points), n_control, degree)
+
+
+def fit_two_part(split: SplitSection, knots_upper=None, knots_lower=None, n_control: int = 12,
+                 degree: int = SECTION_DEGREE, ratio: float | None = None) -> TwoPartFit:
+    """Two constrained least-squares fits with G1 at S and the tangent magnitudes by SQP.
+
+    knots_upper / knots_lower: the knot vectors of the halves (e.g. the blade's common ones,
+    Hosseini §3), or None for :func:`default_knots` with ``n_control`` per half. The
+    magnitudes (λ_u, λ_l) of the derivative at S minimise the total least-squares error
+    (Eq. 3) with ``scipy.optimize.minimize(method="SLSQP")``, bounded below by
+    :data:`MIN_MAGNITUDE_FRACTION` of the preliminary fit's. ``ratio``: if given, the
+    equality constraint λ_u = ratio · λ_l, which a blade needs so that the halves' cross
+    derivatives stay parallel between its stations (G1 along the whole parting line).
+    """
+    Ku = default_knots(split.upper, n_control, degree) if knots_upper is None else np.asarray(knots_upper)
+    Kl = default_knots(split.lower, n_control, degree) if knots_lower is None else np.asarray(knots_lower)
+    up = _AffineHalf(split.upper, Ku, degree, split.tangent, at_start=False)
+    lo = _AffineHalf(split.lower, Kl, degree, split.tangent, at_start=True)
+    scale = np.array([split.magnitude_upper, split.magnitude_lower])
+    norm = split.chord**2
+
+    def objective(x):
+        lam = x * scale
+        return (up.error(lam[0]) + lo.error(lam[1])) / norm
+
+    def gradient(x):
+        lam = x * scale
+        return np.array([up.gradient(lam[0]), lo.gradient(lam[1])]) * scale / norm
+
+    constraints = ()
+    if ratio is not None:
+        a = np.array([scale[0], -ratio * scale[1]])
+        constraints = ({"type": "eq", "fun": lambda x: float(a @ x), "jac": lambda x: a},)
+    result = minimize(objective, np.ones(2), jac=gradient, method="SLSQP",
+                      bounds=[(MIN_MAGNITUDE_FRACTION, None)] * 2, constraints=constraints,
+                      options={"ftol": SLSQP_FTOL, "maxiter": 200})
+    lam_u, lam_l = result.x * scale
+    cu, cl = up._fit(lam_u), lo._fit(lam_l)
+    ru = _residual(cu, split.upper[:-1], up.params[:-1])
+    rl = _residual(cl, split.lower[1:], lo.params[1:])
+    err = float(np.sum(ru**2) + np.sum(rl**2))
+    mx = float(max(np.linalg.norm(ru, axis=1).max(), np.linalg.norm(rl, axis=1).max()))
+    return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, int(result.nit))
+
+
+@dataclass(frozen=True, eq=False)
+class SingleFit:
+    """The traditional single-curve fit of a whole section (TE -> LE -> TE), C0 at the TE."""
+
+    curve: BSplineCurve
+    lsq_error: float
+    max_residual: float
+
+
+def fit_single(points, knots=None, n_control: int = 23, degree: int = SECTION_DEGREE) -> SingleFit:
+    """Least-squares fit of the whole section, ends interpolated (NURBS Book §9.4.1), on
+    ``knots`` or the approximation knots for ``n_control`` (Eqs. 9.68–9.69)."""
+    Q = np.asarray(points, dtype=np.float64)
+    t = parameterize(Q)
+    K = approximation_knots(t, n_control, degree) if knots is None else np.asarray(knots)
+    c = fit_least_squares(Q, len(K) - degree - 1, degree, params=t, knots=K)
+    r = _residual(c, Q, t)
+    return SingleFit(c, float(np.sum(r**2)), float(np.linalg.norm(r, axis=1).max()))

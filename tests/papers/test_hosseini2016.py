@@ -1,0 +1,117 @@
+"""Hosseini & Moetakef-Imani (2016): the S823 comparisons of Figs. 5, 7b, 8, 10 and 11.
+
+Our numbers (S823 at unit chord, flat section, mold direction +y; least-squares error
+Σ|Q_r - C(t_r)|² of Eq. 3 over the 199 data points). n = control points per half.
+
+Figs. 5 / 7b / 8 (section)::
+
+     n  two-part LSQ   single(n)     single(2n-1)  λ_upper  λ_lower
+     5  5.188e-02      4.956e-01     1.072e-02     0.7785   1.2181
+     6  7.434e-03      3.097e-01     1.411e-03     0.8831   1.2611
+     8  6.815e-04      5.768e-02     4.018e-04     0.9871   0.8409
+    10  7.729e-05      1.128e-02     9.398e-05     1.0638   1.0874
+    12  1.864e-05      3.023e-03     1.834e-05     1.1048   1.1276
+    14  4.649e-06      1.036e-03     5.216e-06     1.1040   1.0800
+    16  1.123e-06      5.894e-04     1.756e-06     1.0924   1.0886
+    18  3.634e-07      2.808e-04     6.365e-07     1.0784   1.0918
+    20  1.321e-07      1.336e-04     2.509e-07     1.0657   1.0831
+
+- Fig. 5: the two-part error falls at every step of the sweep.
+- Fig. 7b: the optimised magnitudes vary with n (0.78 -> 1.10 -> 1.07 upper).
+- Fig. 8: with the same count per curve (single curve n, each half n) the two-part error
+  is lower at every n. With the same total of distinct control points (single 2n - 1,
+  S shared) it is lower only from n = 10 (10, 14-20; n = 12 is within 2 %): at low counts
+  the fixed tangent at S costs more than the split gains. The paper's "lower at every
+  count" therefore holds for the per-curve count, not for equal totals.
+
+Figs. 10-11 (the S823 small blade, data/blades/s823_small.toml, aero zone: two-part =
+upper + lower, single = one surface with 2n - 1 control points per section)::
+
+     n   MVS two-part  MVS single   SE two-part  SE single
+     6   1.32e+06      4.94e+06     304.3        348.7
+     8   1.08e+07      9.60e+06     394.6        382.0
+    10   1.50e+07      2.97e+07     481.5        486.9
+    12   3.28e+07      4.80e+07     546.2        527.4
+    14   4.83e+07      5.88e+07     561.0        539.5
+    16   6.14e+07      6.86e+07     567.9        549.7
+    18   7.26e+07      7.57e+07     570.3        556.0
+    20   8.01e+07      7.89e+07     569.7        558.6
+
+- MVS: two-part lower at 6 of 8 counts (not at n = 8 and 20).
+- Strain energy: two-part lower only at n = 6 and 10; above that the single surface is
+  1-4 % lower. The paper's Fig. 11 claim is NOT reproduced for n >= 12 with these data.
+The tests assert what holds and pin the measured outcome of what does not.
+"""
+import pathlib
+
+import numpy as np
+import pytest
+
+from bladesmith.geometry.mold import build_blade, fit_single, fit_two_part, load_preset, section_points, split_section
+from bladesmith.geometry.sections.airfoil_file import read_airfoil
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+COUNTS = [5, 6, 8, 10, 12, 14, 16, 18, 20]
+BLADE_COUNTS = [6, 8, 10, 12, 14, 16, 18, 20]
+
+
+@pytest.fixture(scope="module")
+def sweep():
+    foil = read_airfoil(ROOT / "data" / "blades" / "airfoils" / "s823.dat")
+    xy = foil.outline
+    Q = section_points(xy, 1.0, 1.0, 0.0, 0.0, wrap=False)
+    sp = split_section(Q, xy[:, 0], 1.0, (0.0, 1.0, 0.0), wrap=False)
+    rows = []
+    for n in COUNTS:
+        f = fit_two_part(sp, n_control=n)
+        rows.append((n, f.lsq_error, fit_single(Q, n_control=n).lsq_error, fit_single(Q, n_control=2 * n - 1).lsq_error,
+                     f.magnitude_upper, f.magnitude_lower))
+    print("\n  n  two-part     single(n)    single(2n-1) λ_up    λ_lo")
+    for r in rows:
+        print(f"{r[0]:3d}  {r[1]:.3e}    {r[2]:.3e}    {r[3]:.3e}    {r[4]:.4f}  {r[5]:.4f}")
+    return np.array(rows)
+
+
+def test_fig5_error_falls_with_control_points(sweep):
+    assert np.all(np.diff(sweep[:, 1]) < 0)
+
+
+def test_fig7b_optimised_magnitude_varies_with_count(sweep):
+    for col in (4, 5):
+        assert np.ptp(sweep[:, col]) > 0.2 * np.mean(sweep[:, col])
+
+
+def test_fig8_two_part_below_single_at_every_count(sweep):
+    assert np.all(sweep[:, 1] < sweep[:, 2])
+
+
+def test_fig8_equal_totals_crossover(sweep):
+    lower = sweep[:, 1] < sweep[:, 3]
+    assert not lower[0] and lower[COUNTS.index(10)] and np.all(lower[COUNTS.index(14):])
+
+
+@pytest.fixture(scope="module")
+def blade_sweep():
+    d = load_preset("S823_SMALL")
+    rows = []
+    for n in BLADE_COUNTS:
+        m = build_blade(d, control_points=n, adapt=False, tolerance=1.0)
+        f = m.fairness
+        rows.append((n, f["two_part"]["mvs"], f["single"]["mvs"], f["two_part"]["strain_energy"],
+                     f["single"]["strain_energy"]))
+    print("\n  n  MVS two-part  MVS single  SE two-part  SE single")
+    for r in rows:
+        print(f"{r[0]:3d}  {r[1]:.3e}   {r[2]:.3e}  {r[3]:.1f}   {r[4]:.1f}")
+    return np.array(rows)
+
+
+def test_fig10_mvs_two_part_lower_at_most_counts(blade_sweep):
+    lower = blade_sweep[:, 1] < blade_sweep[:, 2]
+    assert lower.sum() >= 6
+
+
+def test_fig11_strain_energy_measured_outcome(blade_sweep):
+    # lower at low counts only; recorded, not the paper's claim (see the module docstring)
+    lower = blade_sweep[:, 3] < blade_sweep[:, 4]
+    assert lower[0]
+    assert np.all(np.abs(blade_sweep[:, 3] / blade_sweep[:, 4] - 1) < 0.15)

@@ -1,0 +1,89 @@
+"""MVS and strain energy (Hosseini 2016 Eq. 6) against closed forms on exact rational
+patches: a cylinder (κ1 = 1/R, κ2 = 0), a sphere zone (κ1 = κ2 = 1/R) and an elliptic
+cylinder, whose MVS is H ∫ (dκ/ds)² ds along the ellipse."""
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from bladesmith.geometry.errors import GeometryError
+from bladesmith.geometry.fairing.surface_fairness import principal_curvatures, surface_fairness
+from bladesmith.geometry.nurbs import BSplineSurface
+
+#: Relative accuracy of the quadrature against the closed forms.
+REL_TOL = 1e-8
+QUAD_KNOTS = np.array([0, 0, 0, 1, 1, 1.0])
+LIN_KNOTS = np.array([0, 0, 1, 1.0])
+
+
+def arc(theta0, theta1, R=1.0):
+    """Rational quadratic circular arc (NURBS Book Eq. 7.x): points (3, 2), weights (3,)."""
+    half = 0.5 * (theta1 - theta0)
+    mid = 0.5 * (theta0 + theta1)
+    P = np.array([[np.cos(theta0), np.sin(theta0)], [np.cos(mid) / np.cos(half), np.sin(mid) / np.cos(half)],
+                  [np.cos(theta1), np.sin(theta1)]]) * R
+    return P, np.array([1.0, np.cos(half), 1.0])
+
+
+def extruded(P2, w, H):
+    net = np.zeros((3, 2, 3))
+    net[:, :, :2] = P2[:, None, :]
+    net[:, 1, 2] = H
+    return BSplineSurface(2, 1, QUAD_KNOTS, LIN_KNOTS, net, np.repeat(w[:, None], 2, axis=1))
+
+
+def test_cylinder():
+    R, H = 2.0, 3.0
+    s = extruded(*arc(0, np.pi / 2, R), H)
+    f = surface_fairness(s)
+    area = np.pi / 2 * R * H
+    assert f.area == pytest.approx(area, rel=REL_TOL)
+    assert f.strain_energy == pytest.approx(area / R**2, rel=REL_TOL)
+    assert f.mvs == pytest.approx(0.0, abs=1e-20)
+
+
+def test_sphere_zone():
+    R = 1.5
+    Pm, wm = arc(0.0, np.pi / 4, R)  # meridian (r, z)
+    Pl, wl = arc(0.0, np.pi / 2, 1.0)  # longitude
+    net = np.zeros((3, 3, 3))
+    net[..., 0] = Pm[:, 0, None] * Pl[None, :, 0]
+    net[..., 1] = Pm[:, 0, None] * Pl[None, :, 1]
+    net[..., 2] = Pm[:, 1, None]
+    s = BSplineSurface(2, 2, QUAD_KNOTS, QUAD_KNOTS, net, wm[:, None] * wl[None, :])
+    f = surface_fairness(s, 8)
+    area = R**2 * np.pi / 2 * np.sin(np.pi / 4)
+    assert f.area == pytest.approx(area, rel=REL_TOL)
+    assert f.strain_energy == pytest.approx(2 * area / R**2, rel=REL_TOL)
+    assert f.mvs == pytest.approx(0.0, abs=1e-16)
+    c = principal_curvatures(s, np.array([0.3]), np.array([0.6]))
+    assert abs(c["k1"][0]) == pytest.approx(1 / R, rel=1e-12) and abs(c["k2"][0]) == pytest.approx(1 / R, rel=1e-12)
+
+
+def test_elliptic_cylinder_mvs():
+    a, b, H = 2.0, 1.0, 0.5
+    P = np.array([[a, 0.0], [a, b], [0.0, b]])
+    s = extruded(P, np.array([1.0, np.sqrt(0.5), 1.0]), H)
+
+    def speed(t):
+        return np.sqrt(a**2 * np.sin(t) ** 2 + b**2 * np.cos(t) ** 2)
+
+    def dk_dt(t):
+        return -1.5 * a * b * speed(t) ** -5 * 2 * (a**2 - b**2) * np.sin(t) * np.cos(t)
+
+    mvs = H * quad(lambda t: dk_dt(t) ** 2 / speed(t), 0, np.pi / 2, epsabs=1e-14, epsrel=1e-13)[0]
+    se = H * quad(lambda t: (a * b / speed(t) ** 3) ** 2 * speed(t), 0, np.pi / 2, epsabs=1e-14, epsrel=1e-13)[0]
+    f = surface_fairness(s, 40)
+    assert f.mvs == pytest.approx(mvs, rel=1e-6)
+    assert f.strain_energy == pytest.approx(se, rel=1e-8)
+    # unit principal directions: the curved one along the ellipse, the flat one along z
+    c = principal_curvatures(s, np.array([0.37]), np.array([0.5]))
+    curved = "1" if abs(c["k1"][0]) > abs(c["k2"][0]) else "2"
+    flat = "2" if curved == "1" else "1"
+    assert np.linalg.norm(c["e" + curved][0]) == pytest.approx(1.0, rel=1e-12)
+    assert abs(c["e" + curved][0][2]) < 1e-12
+    assert abs(abs(c["e" + flat][0][2]) - 1.0) < 1e-12
+
+
+def test_refuses_non_surfaces():
+    with pytest.raises(GeometryError):
+        surface_fairness("not a surface")
