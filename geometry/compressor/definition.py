@@ -1,0 +1,373 @@
+"""Impeller definition files (TOML) and the impeller model built from them.
+
+Format (lengths in metres, angles in degrees; see README "Impeller definition")::
+
+    name = "Intermediate flow coefficient impeller"
+
+    [channel]                      # Casey (1983) Fig. 5 skeletal data, inlet to outlet
+    degrees = [1, 4, 4, 1]         # per patch: 1 straight wall, 4 bend (see channel.py)
+    hub_z = [...]                  # patch-corner axial positions, n+1 values
+    hub_r = [...]                  # patch-corner radii
+    hub_angle = ["auto", ...]      # wall direction at each corner, deg from +z towards +r;
+                                   # "auto" next to a straight patch takes its direction
+    hub_fractions = [[fa, fb], ...]  # per patch, placing P_1 and P_3 of a bend
+    shroud_z = [...]; shroud_r = [...]; shroud_angle = [...]; shroud_fractions = [...]
+
+    [blade]
+    count = 15                     # Z
+    leading_edge_hub = 1.0         # channel parameter U of the four blade corners
+    leading_edge_shroud = 1.0      # (Casey 1983 step b); U in [0, patches of the channel]
+    trailing_edge_hub = 3.0
+    trailing_edge_shroud = 3.0
+    beta_hub = [b0, ..., bk]       # Bernstein coefficients of β(m̄) (deg), m̄ in [0, 1]:
+    beta_shroud = [...]            # the first and last are the LE and TE angles
+    thickness_hub = [...]          # Bernstein coefficients of δ(m̄) (m), all >= 0
+    thickness_shroud = [...]
+    patches = 6                    # cubic-linear patches per surface
+    lean_hub = 0.0                 # φ of the camber LE on hub and shroud (deg)
+    lean_shroud = 0.0
+    elements = "arbitrary"         # or "axial" (Casey's axial-element blades)
+    leading_edge_ratio = 3.0       # rounded LE: ellipse semi-axes ratio; 0 = not rounded
+    trailing_edge_ratio = 0.0
+
+    [splitter]                     # optional: a shortened copy of the main camber line
+    leading_edge_hub = 1.6
+    leading_edge_shroud = 1.5
+    thickness_hub = [...]
+    thickness_shroud = [...]
+    pitch_fraction = 0.5           # φ offset in blade pitches 2π/Z
+    patches = 4
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..errors import DefinitionError
+from .blade import MAX_BETA_DEG, BladeSurfaces, WallBlade, WallCamber, build_blade
+from .channel import MeridionalChannel, WallSkeleton, channel_from_skeleton
+
+WALLS = ("hub", "shroud")
+
+
+def _floats(data: dict, key: str, section: str, path, length: int | None = None) -> tuple:
+    name = f"{section}.{key}"
+    if key not in data:
+        raise DefinitionError("missing", path=path, field=name)
+    value = data[key]
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise DefinitionError(f"expected numbers, got {value!r}", path=path, field=name) from None
+    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
+        raise DefinitionError(f"expected a list of finite numbers, got {value!r}", path=path, field=name)
+    if length is not None and arr.size != length:
+        raise DefinitionError(f"expected {length} values, got {arr.size}", path=path, field=name)
+    return tuple(float(x) for x in arr)
+
+
+def _number(data: dict, key: str, section: str, path, default=None) -> float:
+    name = f"{section}.{key}"
+    if key not in data:
+        if default is None:
+            raise DefinitionError("missing", path=path, field=name)
+        return float(default)
+    v = data[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise DefinitionError(f"expected a number, got {v!r}", path=path, field=name)
+    return float(v)
+
+
+@dataclass(frozen=True)
+class ChannelDefinition:
+    degrees: tuple
+    hub_z: tuple
+    hub_r: tuple
+    hub_angle: tuple  # NaN = "auto"
+    hub_fractions: tuple
+    shroud_z: tuple
+    shroud_r: tuple
+    shroud_angle: tuple
+    shroud_fractions: tuple
+
+    @classmethod
+    def from_dict(cls, data: dict, path=None) -> "ChannelDefinition":
+        if "degrees" not in data:
+            raise DefinitionError("missing", path=path, field="channel.degrees")
+        degrees = tuple(int(d) for d in data["degrees"])
+        n = len(degrees)
+        values = {"degrees": degrees}
+        for w in WALLS:
+            values[f"{w}_z"] = _floats(data, f"{w}_z", "channel", path, n + 1)
+            values[f"{w}_r"] = _floats(data, f"{w}_r", "channel", path, n + 1)
+            raw = data.get(f"{w}_angle", ["auto"] * (n + 1))
+            if len(raw) != n + 1:
+                raise DefinitionError(f"expected {n + 1} values", path=path, field=f"channel.{w}_angle")
+            angles = []
+            for a in raw:
+                if a == "auto":
+                    angles.append(math.nan)
+                elif isinstance(a, (int, float)) and not isinstance(a, bool):
+                    angles.append(float(a))
+                else:
+                    raise DefinitionError(f"expected a number or \"auto\", got {a!r}", path=path, field=f"channel.{w}_angle")
+            values[f"{w}_angle"] = tuple(angles)
+            fr = data.get(f"{w}_fractions", [[0.5, 0.5]] * n)
+            try:
+                fr = np.asarray(fr, dtype=float)
+            except (TypeError, ValueError):
+                raise DefinitionError("expected pairs of numbers", path=path, field=f"channel.{w}_fractions") from None
+            if fr.shape != (n, 2):
+                raise DefinitionError(f"expected {n} pairs, got shape {fr.shape}", path=path, field=f"channel.{w}_fractions")
+            values[f"{w}_fractions"] = tuple(map(tuple, fr.tolist()))
+        return cls(**values)
+
+    def to_dict(self) -> dict:
+        out = {"degrees": list(self.degrees)}
+        for w in WALLS:
+            out[f"{w}_z"] = list(getattr(self, f"{w}_z"))
+            out[f"{w}_r"] = list(getattr(self, f"{w}_r"))
+            out[f"{w}_angle"] = ["auto" if math.isnan(a) else a for a in getattr(self, f"{w}_angle")]
+            out[f"{w}_fractions"] = [list(p) for p in getattr(self, f"{w}_fractions")]
+        return out
+
+    def build(self, path=None) -> MeridionalChannel:
+        walls = {}
+        for w in WALLS:
+            walls[w] = WallSkeleton(
+                np.column_stack([getattr(self, f"{w}_z"), getattr(self, f"{w}_r")]),
+                np.array(getattr(self, f"{w}_angle"), dtype=float),
+                np.array(getattr(self, f"{w}_fractions"), dtype=float),
+            )
+        return channel_from_skeleton(self.degrees, walls["hub"], walls["shroud"], path)
+
+
+BLADE_SCALARS = {
+    "leading_edge_hub": None, "leading_edge_shroud": None, "trailing_edge_hub": None, "trailing_edge_shroud": None,
+    "lean_hub": 0.0, "lean_shroud": 0.0, "leading_edge_ratio": 3.0, "trailing_edge_ratio": 0.0,
+}
+
+
+@dataclass(frozen=True)
+class BladeDefinition:
+    count: int
+    leading_edge_hub: float
+    leading_edge_shroud: float
+    trailing_edge_hub: float
+    trailing_edge_shroud: float
+    beta_hub: tuple
+    beta_shroud: tuple
+    thickness_hub: tuple
+    thickness_shroud: tuple
+    patches: int = 6
+    lean_hub: float = 0.0
+    lean_shroud: float = 0.0
+    elements: str = "arbitrary"
+    leading_edge_ratio: float = 3.0
+    trailing_edge_ratio: float = 0.0
+
+    @classmethod
+    def from_dict(cls, data: dict, path=None) -> "BladeDefinition":
+        s = "blade"
+        count = data.get("count")
+        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            raise DefinitionError(f"expected a positive integer, got {count!r}", path=path, field="blade.count")
+        patches = data.get("patches", 6)
+        if isinstance(patches, bool) or not isinstance(patches, int) or patches < 1:
+            raise DefinitionError(f"expected a positive integer, got {patches!r}", path=path, field="blade.patches")
+        elements = data.get("elements", "arbitrary")
+        if elements not in ("arbitrary", "axial"):
+            raise DefinitionError(f"expected \"arbitrary\" or \"axial\", got {elements!r}", path=path, field="blade.elements")
+        values = {k: _number(data, k, s, path, d) for k, d in BLADE_SCALARS.items()}
+        for w in WALLS:
+            values[f"beta_{w}"] = _floats(data, f"beta_{w}", s, path)
+            values[f"thickness_{w}"] = _floats(data, f"thickness_{w}", s, path)
+        return cls(count=count, patches=patches, elements=elements, **values)
+
+    def to_dict(self) -> dict:
+        out = {}
+        for k, v in self.__dict__.items():
+            out[k] = list(v) if isinstance(v, tuple) else v
+        return out
+
+
+@dataclass(frozen=True)
+class SplitterDefinition:
+    leading_edge_hub: float
+    leading_edge_shroud: float
+    thickness_hub: tuple
+    thickness_shroud: tuple
+    pitch_fraction: float = 0.5
+    patches: int = 4
+    leading_edge_ratio: float = 3.0
+
+    @classmethod
+    def from_dict(cls, data: dict, path=None) -> "SplitterDefinition":
+        s = "splitter"
+        patches = data.get("patches", 4)
+        if isinstance(patches, bool) or not isinstance(patches, int) or patches < 1:
+            raise DefinitionError(f"expected a positive integer, got {patches!r}", path=path, field="splitter.patches")
+        return cls(
+            leading_edge_hub=_number(data, "leading_edge_hub", s, path),
+            leading_edge_shroud=_number(data, "leading_edge_shroud", s, path),
+            thickness_hub=_floats(data, "thickness_hub", s, path),
+            thickness_shroud=_floats(data, "thickness_shroud", s, path),
+            pitch_fraction=_number(data, "pitch_fraction", s, path, 0.5),
+            patches=patches,
+            leading_edge_ratio=_number(data, "leading_edge_ratio", s, path, 3.0),
+        )
+
+    def to_dict(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
+
+
+@dataclass(frozen=True, eq=False)
+class ImpellerModel:
+    """The float64 model: channel M, the reference blade (B, S, P at φ as defined), the
+    splitter (or None) and the blade count Z. Blade k is the reference turned by 2πk/Z."""
+
+    name: str
+    channel: MeridionalChannel
+    blade: BladeSurfaces
+    splitter: BladeSurfaces | None
+    count: int
+
+    def blade_angle(self, k: int) -> float:
+        return 2.0 * math.pi * k / self.count
+
+
+@dataclass(frozen=True)
+class ImpellerDefinition:
+    name: str
+    channel: ChannelDefinition
+    blade: BladeDefinition
+    splitter: SplitterDefinition | None = None
+    path: str | None = field(default=None, compare=False)
+
+    @classmethod
+    def from_dict(cls, data: dict, path=None) -> "ImpellerDefinition":
+        path = None if path is None else str(path)
+        if not isinstance(data.get("channel"), dict):
+            raise DefinitionError("missing [channel] table", path=path, field="channel")
+        if not isinstance(data.get("blade"), dict):
+            raise DefinitionError("missing [blade] table", path=path, field="blade")
+        splitter = data.get("splitter")
+        return cls(
+            name=str(data.get("name", "Impeller")),
+            channel=ChannelDefinition.from_dict(data["channel"], path),
+            blade=BladeDefinition.from_dict(data["blade"], path),
+            splitter=None if splitter is None else SplitterDefinition.from_dict(splitter, path),
+            path=path,
+        )
+
+    @classmethod
+    def from_toml(cls, path) -> "ImpellerDefinition":
+        try:
+            with open(path, "rb") as fh:
+                data = tomllib.load(fh)
+        except OSError as exc:
+            raise DefinitionError(f"cannot read: {exc.strerror}", path=str(path)) from None
+        except tomllib.TOMLDecodeError as exc:
+            raise DefinitionError(f"not valid TOML: {exc}", path=str(path)) from None
+        return cls.from_dict(data, path)
+
+    def to_dict(self) -> dict:
+        out = {"name": self.name, "channel": self.channel.to_dict(), "blade": self.blade.to_dict()}
+        if self.splitter is not None:
+            out["splitter"] = self.splitter.to_dict()
+        return out
+
+    def with_values(self, **changes) -> "ImpellerDefinition":
+        return replace(self, **changes)
+
+    # -- validation and building ---------------------------------------------------------
+    def _check_blade(self, n: int) -> None:
+        b, p = self.blade, self.path
+        for w in WALLS:
+            le, te = getattr(b, f"leading_edge_{w}"), getattr(b, f"trailing_edge_{w}")
+            for key, val in ((f"leading_edge_{w}", le), (f"trailing_edge_{w}", te)):
+                if not 0.0 <= val <= n:
+                    raise DefinitionError(f"U = {val} lies outside the channel [0, {n}]", path=p, field=f"blade.{key}")
+            if le >= te:
+                raise DefinitionError(
+                    f"the leading edge (U = {le}) must lie before the trailing edge (U = {te})",
+                    path=p, field=f"blade.leading_edge_{w}",
+                )
+            th = np.asarray(getattr(b, f"thickness_{w}"))
+            if np.any(th < 0.0):
+                raise DefinitionError(f"thickness must be >= 0, got {th.min()}", path=p, field=f"blade.thickness_{w}")
+            beta = np.asarray(getattr(b, f"beta_{w}"))
+            if np.any(np.abs(beta) >= MAX_BETA_DEG):
+                raise DefinitionError(f"|β| must stay below {MAX_BETA_DEG} deg", path=p, field=f"blade.beta_{w}")
+        if b.leading_edge_ratio < 0 or b.trailing_edge_ratio < 0:
+            raise DefinitionError("edge ratios must be >= 0", path=p, field="blade.leading_edge_ratio")
+        s = self.splitter
+        if s is not None:
+            for w in WALLS:
+                le = getattr(s, f"leading_edge_{w}")
+                if not getattr(b, f"leading_edge_{w}") < le < getattr(b, f"trailing_edge_{w}"):
+                    raise DefinitionError(
+                        "the splitter leading edge must lie between the main blade's leading and trailing edges",
+                        path=p, field=f"splitter.leading_edge_{w}",
+                    )
+                th = np.asarray(getattr(s, f"thickness_{w}"))
+                if np.any(th < 0.0):
+                    raise DefinitionError(f"thickness must be >= 0, got {th.min()}", path=p, field=f"splitter.thickness_{w}")
+
+    def build(self) -> ImpellerModel:
+        """Validate and build the float64 model (channel, blade, splitter)."""
+        channel = self.channel.build(self.path)
+        self._check_blade(channel.count)
+        b = self.blade
+        cambers = {
+            w: WallCamber(
+                channel.wall(w), getattr(b, f"leading_edge_{w}"), getattr(b, f"trailing_edge_{w}"),
+                getattr(b, f"beta_{w}"), math.radians(getattr(b, f"lean_{w}")),
+            )
+            for w in WALLS
+        }
+        axial = b.elements == "axial"
+        walls = {
+            w: WallBlade(cambers[w], cambers[w].U0, cambers[w].U1, np.asarray(getattr(b, f"thickness_{w}")))
+            for w in WALLS
+        }
+        blade = build_blade(channel, walls["hub"], walls["shroud"], b.patches, axial, b.leading_edge_ratio, b.trailing_edge_ratio)
+        splitter = None
+        s = self.splitter
+        if s is not None:
+            offset = 2.0 * math.pi * s.pitch_fraction / b.count
+            swalls = {
+                w: WallBlade(cambers[w], getattr(s, f"leading_edge_{w}"), cambers[w].U1,
+                             np.asarray(getattr(s, f"thickness_{w}")), offset)
+                for w in WALLS
+            }
+            splitter = build_blade(channel, swalls["hub"], swalls["shroud"], s.patches, axial, s.leading_edge_ratio, b.trailing_edge_ratio)
+        return ImpellerModel(self.name, channel, blade, splitter, b.count)
+
+
+def dumps_toml(data: dict, header: str = "") -> str:
+    """TOML text of a definition dictionary (flat tables of numbers, strings and lists)."""
+
+    def value(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, str):
+            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        if isinstance(v, (list, tuple)):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        if isinstance(v, float):
+            return repr(v)
+        return str(v)
+
+    lines = [header.rstrip()] if header else []
+    for k, v in data.items():
+        if not isinstance(v, dict):
+            lines.append(f"{k} = {value(v)}")
+    for k, v in data.items():
+        if isinstance(v, dict):
+            lines.append(f"\n[{k}]")
+            lines.extend(f"{kk} = {value(vv)}" for kk, vv in v.items())
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,119 @@
+"""The impeller as a list of named exact surfaces, for the Blender display and IGES.
+
+Channel walls: rational surfaces of revolution of degree (p, 2) (IGES 128); blades: the
+S and P patch strings and the rounded end patches as degree (3, 1) B-splines (IGES 128,
+Casey's cubic-linear patches), blade k turned by 2πk/Z (exact rotation of the polygons).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..nurbs import BSplineSurface
+from ..nurbs.fitting import greville_abscissae, interpolate_at
+from .bezier import BezierString, PatchString
+from .channel import full_circle
+from .definition import ImpellerModel
+
+#: A knot-reduced form is used only if it reproduces the Bézier form to this (relative).
+REDUCTION_TOLERANCE = 1e-12
+
+
+def _reduced_string(string: BezierString, multiplicity: int, spans=None):
+    """The string as a B-spline with interior knots of lower ``multiplicity`` (knot
+    removal done as exact interpolation at the Greville abscissae, The NURBS Book 2e
+    §9.2.1: the string lies in the smaller spline space, so the interpolant is the string),
+    or None when the string is not smooth enough for it. ``spans``: knot-span lengths
+    (default 1 per patch)."""
+    n, p = string.count, string.max_degree
+    h = np.ones(n) if spans is None else np.asarray(spans, float)
+    breaks = np.r_[0.0, np.cumsum(h)]
+    knots = np.r_[np.zeros(p + 1), np.repeat(breaks[1:-1], multiplicity), np.full(p + 1, breaks[-1])]
+    g = greville_abscissae(knots, p)
+    k = np.clip(np.searchsorted(breaks, g, side="right") - 1, 0, n - 1)
+    U = k + (g - breaks[k]) / h[k]
+    curve = interpolate_at(knots, p, g, string.elevated_to(p).evaluate(U))
+    test = np.linspace(0.0, breaks[-1], 40 * n + 1)
+    kt = np.clip(np.searchsorted(breaks, test, side="right") - 1, 0, n - 1)
+    ref = string.evaluate(kt + (test - breaks[kt]) / h[kt])
+    scale = max(1.0, float(np.abs(ref).max()))
+    if np.max(np.abs(curve.evaluate(test) - ref)) > REDUCTION_TOLERANCE * scale:
+        return None
+    return curve
+
+
+def ruled_bspline(surface: PatchString) -> BSplineSurface:
+    """A cubic-linear patch string as a degree (3, 1) B-spline with simple interior knots
+    when it is C2 (Casey's blades), else in Bézier form."""
+    lo = _reduced_string(surface.lower, 1)
+    up = _reduced_string(surface.upper, 1)
+    if lo is None or up is None:
+        return surface.to_bspline()
+    P = np.stack([lo.control_points, up.control_points], axis=1)
+    return BSplineSurface(lo.degree, 1, lo.knots, np.array([0.0, 0, 1, 1]), P)
+
+
+def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
+    """A wall of revolution as four quarter surfaces (φ in [qπ/2, (q+1)π/2]), each one
+    exact rational quadratic arc in v, so that none is closed and none has a C0 knot in v, with the contour made C1 by choosing the knot spans so that the first
+    derivatives match at the junctions (the channel is G2; interior knots of
+    multiplicity p - 1), falling back to the Bézier form."""
+    p = string.max_degree
+    s = string.elevated_to(p)
+    h = [1.0]
+    for a, b in zip(s.segments[:-1], s.segments[1:]):
+        da = np.linalg.norm(a.control_points[-1] - a.control_points[-2])
+        db = np.linalg.norm(b.control_points[1] - b.control_points[0])
+        h.append(h[-1] * db / da)
+    contour = _reduced_string(s, p - 1, spans=h) if p > 1 else None
+    if contour is None:
+        contour = string.to_bspline()
+    knots_c, circle, w_circle = full_circle()
+    out = []
+    for q in range(4):
+        half = slice(2 * q, 2 * q + 3)
+        c, w = circle[half], w_circle[half]
+        z, r = contour.control_points[:, 0], contour.control_points[:, 1]
+        P = np.empty((len(z), 3, 3))
+        P[..., 0] = r[:, None] * c[None, :, 0]
+        P[..., 1] = r[:, None] * c[None, :, 1]
+        P[..., 2] = z[:, None]
+        kv = np.array([0.0, 0, 0, 1, 1, 1]) * 0.5 * np.pi + 0.5 * np.pi * q
+        out.append(BSplineSurface(contour.degree, 2, contour.knots, kv, P, np.ones(len(z))[:, None] * w[None, :]))
+    return out
+
+
+def blade_surfaces(blade, include_camber: bool = False) -> list[tuple[str, BSplineSurface]]:
+    out = [("S", ruled_bspline(blade.suction)), ("P", ruled_bspline(blade.pressure))]
+    if blade.leading_edge is not None:
+        out.append(("LE", blade.leading_edge.to_bspline()))
+    if blade.trailing_edge is not None:
+        out.append(("TE", blade.trailing_edge.to_bspline()))
+    if include_camber:
+        out.append(("B", ruled_bspline(blade.camber)))
+    return out
+
+
+def impeller_surfaces(model: ImpellerModel, blades: int | None = None, include_camber: bool = False
+                      ) -> list[tuple[str, BSplineSurface]]:
+    """(name, surface) pairs: "hub 1".."hub 4", "shroud 1".."shroud 4" (quarter
+    walls, see :func:`channel_wall_quarters`), then "blade k S" ... for k = 1..blades (default all Z)
+    and "splitter k S" ... when the model has splitters."""
+    out = []
+    for wall in ("hub", "shroud"):
+        for i, surface in enumerate(channel_wall_quarters(model.channel.wall(wall))):
+            out.append((f"{wall} {i + 1}", surface))
+    count = model.count if blades is None else int(blades)
+    reference = {label: blade_surfaces(blade, include_camber)
+                 for label, blade in (("blade", model.blade), ("splitter", model.splitter)) if blade is not None}
+    for k in range(count):
+        c, s = np.cos(model.blade_angle(k)), np.sin(model.blade_angle(k))
+        R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        for label, parts in reference.items():
+            for part, surface in parts:
+                if part == "B" and k:
+                    continue
+                turned = surface if k == 0 else BSplineSurface(
+                    surface.degree_u, surface.degree_v, surface.knots_u, surface.knots_v,
+                    surface.control_points @ R.T, surface.weights)
+                out.append((f"{label} {k + 1} {part}", turned))
+    return out

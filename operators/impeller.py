@@ -1,0 +1,150 @@
+"""Impellers in Blender: ``bpy.ops.bladesmith.add_impeller`` (Casey 1983 channel and blades).
+
+A root Empty named after the definition holds the definition as TOML text
+(``definition_toml``) and the editable values in ``Object.bladesmith_impeller`` (the
+property group of :mod:`..ui.impeller_panel`); its children are SURFACE objects showing
+the exact surfaces of :func:`~..geometry.compressor.export.impeller_surfaces` (channel
+walls as four quarter surfaces of revolution each, blade k's S, P and rounded end patches,
+splitters), each storing its float64 surface, so File > Export > IGES writes them exactly.
+With ``blade_net`` a MESH object shows the (u, v) net of the camber surface B.
+Editing a value in the panel rebuilds the model and replaces the children.
+"""
+import pathlib
+import tomllib
+
+import bpy
+import numpy as np
+from bpy.props import BoolProperty, EnumProperty, IntProperty, StringProperty
+
+from ..geometry.compressor import ImpellerDefinition, blade_net, distribution, dumps_toml
+from ..geometry.compressor.export import impeller_surfaces
+from ..geometry.errors import BladesmithError, DefinitionError
+from .nurbs_objects import surface_to_object
+
+PRESET_DIR = pathlib.Path(__file__).resolve().parent.parent / "data" / "impellers"
+ROOT_KEY = "bladesmith_impeller_root"
+PART_KEY = "bladesmith_part"
+#: Blender evaluation points per control point of the displayed surfaces.
+SURFACE_RESOLUTION = 3
+
+
+def preset_names() -> list[str]:
+    return sorted(p.stem for p in PRESET_DIR.glob("*.toml"))
+
+
+def _preset_items(self, context):
+    return [(n, n.replace("_", " "), f"data/impellers/{n}.toml") for n in preset_names()]
+
+
+def load_definition(definition: str = "", preset: str = "") -> ImpellerDefinition:
+    if definition:
+        return ImpellerDefinition.from_toml(bpy.path.abspath(definition))
+    if preset not in preset_names():
+        raise DefinitionError(f"unknown preset {preset!r}; available: {', '.join(preset_names())}", field="preset")
+    return ImpellerDefinition.from_toml(PRESET_DIR / f"{preset}.toml")
+
+
+def net_to_mesh(net: np.ndarray, name: str, collection):
+    """A structured (nu, nv, 3) net as a grid MESH object (Casey 1983, Figs. 9–10)."""
+    nu, nv, _ = net.shape
+    idx = np.arange(nu * nv).reshape(nu, nv)
+    faces = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], axis=-1).reshape(-1, 4)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(net.reshape(-1, 3).tolist(), [], faces.tolist())
+    obj = bpy.data.objects.new(name, mesh)
+    collection.objects.link(obj)
+    return obj
+
+
+def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_net: bool) -> None:
+    """Build the model and (re)create the root's children; raises BladesmithError."""
+    model = definition.build()
+    surfaces = impeller_surfaces(model, None if full_wheel else 1, include_camber=True)
+    for child in list(root.children):
+        data = child.data
+        bpy.data.objects.remove(child)
+        if data is not None and data.users == 0:
+            (bpy.data.curves if isinstance(data, bpy.types.Curve) else bpy.data.meshes).remove(data)
+    collection = root.users_collection[0]
+    for name, surface in surfaces:
+        obj = surface_to_object(surface, f"{root.name} {name}", collection, SURFACE_RESOLUTION)
+        obj[PART_KEY] = name
+        obj.parent = root
+    if show_net:
+        net = blade_net(model.blade.camber, distribution(41, 1.5, 1.5), distribution(11))
+        obj = net_to_mesh(net, f"{root.name} net B", collection)
+        obj[PART_KEY] = "net B"
+        obj.parent = root
+    root["definition_toml"] = dumps_toml(definition.to_dict())
+
+
+class BLADESMITH_OT_add_impeller(bpy.types.Operator):
+    """Add a centrifugal impeller or return channel (Casey 1983): channel, B/S/P blades, full wheel"""
+
+    bl_idname = "bladesmith.add_impeller"
+    bl_label = "Add Impeller"
+    bl_options = {"REGISTER", "UNDO"}
+
+    definition: StringProperty(name="Definition", description="Impeller TOML file", subtype="FILE_PATH", default="")
+    preset: EnumProperty(name="Preset", items=_preset_items)
+    full_wheel: BoolProperty(name="Full Wheel", description="All Z blades (and splitters), not only the first", default=True)
+    blade_net: BoolProperty(name="Blade Net", description="Add the (u, v) net of the camber surface as a mesh", default=False)
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode == "OBJECT"
+
+    def execute(self, context):
+        try:
+            definition = load_definition(self.definition, self.preset)
+            definition.build()  # validate before touching the scene
+        except BladesmithError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        root = bpy.data.objects.new(definition.name, None)
+        context.collection.objects.link(root)
+        root[ROOT_KEY] = True
+        try:
+            build_children(root, definition, self.full_wheel, self.blade_net)
+        except BladesmithError as exc:
+            for child in list(root.children):
+                bpy.data.objects.remove(child)
+            bpy.data.objects.remove(root)
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        settings = getattr(root, "bladesmith_impeller", None)
+        if settings is not None:
+            settings.load(definition, self.full_wheel)
+        for obj in context.view_layer.objects:
+            obj.select_set(False)
+        root.select_set(True)
+        context.view_layer.objects.active = root
+        return {"FINISHED"}
+
+
+def regenerate(root, definition_dict: dict, full_wheel: bool) -> None:
+    """Rebuild a root's children from an edited definition dictionary (panel edits)."""
+    definition = ImpellerDefinition.from_dict(definition_dict)
+    build_children(root, definition, full_wheel, any(c.get(PART_KEY) == "net B" for c in root.children))
+
+
+def definition_from_root(root) -> dict:
+    return tomllib.loads(root["definition_toml"])
+
+
+_classes = (BLADESMITH_OT_add_impeller,)
+_register, _unregister = bpy.utils.register_classes_factory(_classes)
+
+
+def menu_func(self, context):
+    self.layout.operator(BLADESMITH_OT_add_impeller.bl_idname, text="Impeller (Casey)")
+
+
+def register():
+    _register()
+    bpy.types.VIEW3D_MT_add.append(menu_func)
+
+
+def unregister():
+    bpy.types.VIEW3D_MT_add.remove(menu_func)
+    _unregister()
