@@ -23,6 +23,7 @@ from .convert import (
 )
 from .reader import IgesModel, parse_iges, read_iges
 from .records import (
+    METRES_PER_UNIT,
     UNITS,
     BSplineCurve126,
     BSplineSurface128,
@@ -44,7 +45,7 @@ from .writer import DEFAULT_RESOLUTION, format_real, make_header, to_string, wri
 
 __all__ = [
     "BSplineCurve126", "BSplineSurface128", "CircularArc", "CompositeCurve", "CurveOnSurface",
-    "DEFAULT_RESOLUTION", "DirectoryInfo", "Entity", "GenericEntity", "GlobalSection", "IgesModel",
+    "DEFAULT_RESOLUTION", "DirectoryInfo", "METRES_PER_UNIT", "Entity", "GenericEntity", "GlobalSection", "IgesModel",
     "Line", "ParametricSpline", "ParametricSplineSurface", "SurfaceOfRevolution",
     "TransformationMatrix", "TrimmedSurface", "TrimmedSurfaceGeometry", "UNITS",
     "curve_from_geometry", "curve_geometry", "format_real", "make_header", "parse_iges",

@@ -36,7 +36,7 @@ import numpy as np
 from ..geometry.errors import GeometryError, IgesError
 from ..geometry.nurbs import BSplineSurface
 from .convert import curve_from_geometry, surface_from_geometry
-from .records import UNITS, CompositeCurve, CurveOnSurface, Line, SurfaceOfRevolution, TrimmedSurface
+from .records import METRES_PER_UNIT, UNITS, CompositeCurve, CurveOnSurface, Line, SurfaceOfRevolution, TrimmedSurface
 from .writer import DEFAULT_RESOLUTION, write_iges
 
 #: The five blade surfaces of Hally (2013) §4 / Fig. 2, in the order written, with labels.
@@ -49,10 +49,6 @@ BLADE_SURFACES = (
 )
 HUB_LABEL = "HUB"
 #: Metres per file unit for the unit names ``write_iges`` accepts.
-METRES_PER_UNIT = {
-    "in": 0.0254, "inch": 0.0254, "mm": 1e-3, "ft": 0.3048, "mi": 1609.344, "m": 1.0, "km": 1e3,
-    "mil": 2.54e-5, "um": 1e-6, "cm": 1e-2, "uin": 2.54e-8,
-}
 #: A blade surface's boundary is "on the hub" when it comes this close to it, as a fraction
 #: of the diameter (only used to refuse blade surfaces that do not belong to this hub).
 ROOT_CHECK_FRACTION = 1e-2

@@ -498,6 +498,12 @@ UNITS = {
     "m": (6, "M"), "km": (7, "KM"), "mil": (8, "MIL"), "um": (9, "UM"), "cm": (10, "CM"),
     "uin": (11, "UIN"),
 }
+#: Metres per unit, for every key of :data:`UNITS`.
+METRES_PER_UNIT = {
+    "in": 0.0254, "inch": 0.0254, "mm": 1e-3, "ft": 0.3048, "mi": 1609.344, "m": 1.0, "km": 1e3,
+    "mil": 2.54e-5, "um": 1e-6, "cm": 1e-2, "uin": 2.54e-8,
+}
+
 #: Unit name for each flag, the inverse of :data:`UNITS` (flag 3: the name in field 15 rules).
 UNIT_NAMES = {flag: name for flag, name in UNITS.values()}
 

@@ -7,6 +7,12 @@ from their Blender data with the knot vectors Blender really uses
 the control points (NURBS are affine invariant, so this is exact up to the float32
 matrix Blender stores; identity transforms are skipped and cost nothing).
 
+A tip-smoothed propeller (any of its objects selected, or all) is written the way
+Hally (2013) §11 prescribes instead of object by object: the five surfaces of the
+reference blade as 128 and the hub sector trimmed by the blade footprint as a 144 over a
+120, in the propeller's own coordinates. Rotated copies of a blade are rotated copies of
+these surfaces, which a mesher makes itself.
+
 Import creates exact NURBS objects for 126/128 (and 100, 110, 112, 114, 120 converted to
 B-splines); a trimmed surface (144) comes in as its untrimmed surface plus its trimming
 curves, and the report says so. A failure leaves the scene as it was.
@@ -24,6 +30,7 @@ from ..geometry.errors import BladesmithError
 from ..geometry.nurbs import BSplineCurve, BSplineSurface
 from ..geometry.nurbs.fitting import approximate
 from ..iges import (
+    METRES_PER_UNIT,
     TrimmedSurfaceGeometry,
     curve_from_geometry,
     read_iges,
@@ -33,11 +40,6 @@ from ..iges import (
 from ..iges.convert import surface_points, surface_range
 from .nurbs_objects import curve_to_object, object_to_geometry, surface_to_object
 
-#: Metres per unit for the IGES unit names Bladesmith writes and reads.
-METRES_PER_UNIT = {
-    "IN": 0.0254, "MM": 1e-3, "FT": 0.3048, "MI": 1609.344, "M": 1.0, "KM": 1000.0,
-    "MIL": 2.54e-5, "UM": 1e-6, "CM": 0.01, "UIN": 2.54e-8,
-}
 #: Trimming curves of an imported 144 are approximated on the surface to this fraction of
 #: the surface's size (they have no exact model-space form when the file gives none).
 TRIM_CURVE_TOL = 1e-6
@@ -64,15 +66,61 @@ def _world_geometry(obj) -> list:
     return out
 
 
+def _smoothed_propeller_roots(objects) -> list:
+    """The tip-smoothed propellers that any of ``objects`` belongs to."""
+    from . import propeller
+
+    roots = []
+    for obj in objects:
+        root = propeller.find_root(obj)
+        if root is not None and root.bladesmith_propeller.smooth_tip and root not in roots:
+            roots.append(root)
+    return roots
+
+
+def _propeller_records(root, units: str) -> list:
+    """Hally §11 records of a smoothed propeller: the reference blade's five surfaces (from
+    their stored float64 data) and the hub sector of the model the root's definition makes."""
+    from ..geometry.propeller.hub_sector import hub_sector
+    from ..geometry.propeller.smoothing import SURFACE_NAMES
+    from ..iges.propeller import propeller_iges_entities
+    from . import propeller
+
+    settings = root.bladesmith_propeller
+    model = propeller.build_model(propeller.settings_to_definition(settings))
+    parts = propeller.propeller_parts(root)
+    patches = sorted((patch, obj) for (part, patch, blade), obj in parts.items() if part == "blade" and blade == 0)
+    if len(patches) != len(SURFACE_NAMES):
+        raise BladesmithError(
+            f"propeller '{root.name}': expected {len(SURFACE_NAMES)} blade surfaces, found {len(patches)}; "
+            "regenerate it"
+        )
+    surfaces = {}
+    for name, (_, obj) in zip(SURFACE_NAMES, patches):
+        (surface,) = object_to_geometry(obj)
+        surfaces[name] = surface
+    tolerance = propeller.smoothing_settings(propeller.smoothing_values(settings), model.definition.diameter)["tolerance"]
+    return propeller_iges_entities(model, surfaces, hub_sector(model, tolerance=tolerance), units.lower())
+
+
 def export_objects(objects, filepath: str, units: str = "M", progress=None) -> dict:
     """Write the NURBS of ``objects`` to ``filepath`` (atomically). Returns counts.
 
     Raises :class:`BladesmithError` (nothing is written then) when an object cannot be
     expressed exactly or the data is inconsistent.
     """
-    scale = 1.0 / METRES_PER_UNIT[units]
-    records, counts = [], {"surfaces": 0, "curves": 0, "objects": 0}
-    objects = [o for o in objects if o.type in EXPORTABLE_TYPES]
+    from . import propeller
+
+    scale = 1.0 / METRES_PER_UNIT[units.lower()]
+    records, counts = [], {"surfaces": 0, "curves": 0, "objects": 0, "propellers": 0, "trimmed": 0}
+    roots = _smoothed_propeller_roots(objects)
+    for root in roots:
+        found = _propeller_records(root, units)
+        records.extend(found)
+        counts["propellers"] += 1
+        counts["surfaces"] += len(found) - 1
+        counts["trimmed"] += 1
+    objects = [o for o in objects if o.type in EXPORTABLE_TYPES and propeller.find_root(o) not in roots]
     for i, obj in enumerate(objects):
         try:
             pieces = _world_geometry(obj)
@@ -119,7 +167,7 @@ def import_file(filepath: str, collection, progress=None) -> dict:
     """
     model = read_iges(filepath)
     unit = model.header.unit_name.upper() if model.header.unit_name else "M"
-    factor = METRES_PER_UNIT.get(unit, 1.0) / (model.header.model_scale or 1.0)
+    factor = METRES_PER_UNIT.get(unit.lower(), 1.0) / (model.header.model_scale or 1.0)
     items = model.to_geometry()
     created = []
     counts = {"surfaces": 0, "curves": 0, "trimmed": 0, "trim_curves": 0}
@@ -203,11 +251,13 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
-        self.report(
-            {"INFO"},
-            f"Wrote {counts['surfaces']} surfaces and {counts['curves']} curves from {counts['objects']} "
-            f"objects to {self.filepath} ({self.units.lower()})",
-        )
+        message = f"Wrote {counts['surfaces']} surfaces and {counts['curves']} curves"
+        if counts["propellers"]:
+            message += (
+                f", including {counts['propellers']} smoothed propeller(s) as reference blade and trimmed hub "
+                "sector (Hally 2013 §11)"
+            )
+        self.report({"INFO"}, f"{message} to {self.filepath} ({self.units.lower()})")
         return {"FINISHED"}
 
 

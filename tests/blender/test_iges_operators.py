@@ -1,5 +1,6 @@
 """File > Export > IGES and File > Import > IGES in Blender."""
 import os
+import pathlib
 
 import bpy
 import numpy as np
@@ -11,6 +12,7 @@ from bladesmith.iges import read_iges
 from bladesmith.operators.nurbs_objects import curve_to_object, object_to_geometry, surface_to_object
 
 FLOAT32 = 2e-6  # relative: the float32 precision of Blender coordinates, with margin
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def random_surface(rng, rational):
@@ -187,3 +189,32 @@ def test_menus_are_registered(addon):
 
     assert iges_io._menu_export in bpy.types.TOPBAR_MT_file_export._dyn_ui_initialize()
     assert iges_io._menu_import in bpy.types.TOPBAR_MT_file_import._dyn_ui_initialize()
+
+
+def test_smoothed_propeller_exports_as_reference_blade_and_hub_sector(scene, tmp_path):
+    """Hally (2013) §11: the five reference-blade surfaces (exact, as smoothed) and the hub
+    sector as a trimmed surface, however many rotated copies the scene shows."""
+    from bladesmith.geometry.propeller import Propeller, smooth_blade
+    from bladesmith.iges import BSplineSurface128, TrimmedSurface
+
+    assert bpy.ops.bladesmith.add_propeller(preset="dtmb4119", smooth_tip=True) == {"FINISHED"}
+    rng = np.random.default_rng(9)
+    surface_to_object(random_surface(rng, False), "Other")
+    path = tmp_path / "prop.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(path)) == {"FINISHED"}
+    model = read_iges(path)
+    roots = model.roots
+    assert sum(isinstance(r, TrimmedSurface) for r in roots) == 1
+    blades = [r for r in roots if isinstance(r, BSplineSurface128) and r.label != "Other"]
+    assert len(blades) == 5 and sum(isinstance(r, BSplineSurface128) for r in roots) == 6
+    # the file holds exactly the float64 surfaces the blade objects show
+    shown = [object_to_geometry(o)[0] for o in scene.objects
+             if o.get("bladesmith_part") == "blade" and o.get("bladesmith_blade", 0) == 0]
+    assert sorted(np.asarray(r.control_points).tobytes() for r in blades) == sorted(
+        s.control_points.tobytes() for s in shown)
+    # and they are the Hally surfaces: an independent run with the same settings, given as
+    # fractions of R rather than of D, agrees to the round-off the pipeline amplifies
+    definition = Propeller.from_toml(ROOT / "data" / "propellers" / "dtmb4119.toml")
+    reference = smooth_blade(definition.build(), measure=False)
+    for r, s in zip(blades, reference.surfaces):
+        assert np.abs(np.asarray(r.control_points) - s.control_points).max() < 1e-9 * definition.diameter
