@@ -251,11 +251,11 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
-        message = f"Wrote {counts['surfaces']} surfaces and {counts['curves']} curves"
+        message = f"Wrote {counts['surfaces']} surfaces, {counts['trimmed']} trimmed surfaces and {counts['curves']} curves"
         if counts["propellers"]:
             message += (
-                f", including {counts['propellers']} smoothed propeller(s) as reference blade and trimmed hub "
-                "sector (Hally 2013 §11)"
+                f" ({counts['propellers']} smoothed propeller(s) as reference blade and trimmed hub sector, "
+                "Hally 2013 §11)"
             )
         self.report({"INFO"}, f"{message} to {self.filepath} ({self.units.lower()})")
         return {"FINISHED"}

@@ -1,14 +1,16 @@
 """The README's main job, headless: ``make demo`` (or ``.venv/bin/python scripts/demo.py``).
 
-Until the propeller pipeline exists (issues 4 and 5), it builds a demonstration blade-like
-bicubic NURBS surface (twisted, cambered, with a non-uniform knot vector and weights) plus
-its leading-edge curve, shows them exactly in Blender, and writes:
+Builds the tip-smoothed DTMB 4119 propeller from the shipped preset with the scripting
+contract a user would use (``bpy.ops.bladesmith.add_propeller``), then writes
 
-- ``OUT/demo.blend``: the scene, whose objects carry their exact float64 data;
-- ``OUT/demo.igs``: IGES written from the float64 model (when the IGES writer is present).
+- ``OUT/dtmb4119.blend``: the scene (the objects keep their exact float64 data);
+- ``OUT/dtmb4119.igs``: the reference blade's five surfaces and the trimmed hub sector,
+  written from the float64 model by ``bpy.ops.export_scene.iges`` (Hally 2013 §11);
+- ``OUT/dtmb4119_review.png``: a curvature review image (pressure side, suction side,
+  tip close-up, with the legend).
 
-It prints what it did: counts, sizes and the largest distance between Blender's evaluated
-mesh and the float64 surface.
+It prints what it did: counts, the deviation of the smoothed blade from the section
+table's blade, the shared-edge gaps, and the time of each step.
 """
 from __future__ import annotations
 
@@ -19,6 +21,7 @@ import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+PRESET = "DTMB4119"
 
 
 def load_addon():
@@ -31,31 +34,6 @@ def load_addon():
     return module
 
 
-def demo_surface():
-    """A twisted, cambered blade-like patch: chordwise u, spanwise v, rational."""
-    import numpy as np
-
-    from bladesmith.geometry.nurbs import BSplineSurface
-
-    nu, nv = 9, 7
-    s = np.linspace(0.0, 1.0, nu)
-    span = np.linspace(0.2, 1.0, nv)
-    net = np.empty((nu, nv, 3))
-    for j, r in enumerate(span):
-        chord = 0.35 * (1.2 - r) ** 0.5
-        twist = np.radians(60.0 - 35.0 * r)
-        x = (s - 0.5) * chord
-        y = 0.08 * chord * np.sin(np.pi * s)  # camber
-        net[:, j, 0] = x * np.cos(twist) - y * np.sin(twist)
-        net[:, j, 1] = x * np.sin(twist) + y * np.cos(twist)
-        net[:, j, 2] = r
-    knots_u = [0, 0, 0, 0, 0.12, 0.3, 0.5, 0.7, 0.88, 1, 1, 1, 1]
-    knots_v = [0, 0, 0, 0, 0.25, 0.45, 0.7, 1, 1, 1, 1]
-    weights = np.ones((nu, nv))
-    weights[4, :] = 1.4
-    return BSplineSurface(3, 3, knots_u, knots_v, net, weights)
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out", help="output folder (created)")
@@ -64,44 +42,61 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
 
     import bpy
-    import numpy as np
 
     addon = load_addon()
     addon.register()
-    from bladesmith.geometry.nurbs.projection import closest_point_surface
-    from bladesmith.operators.nurbs_objects import curve_to_object, surface_to_object
+    try:
+        from bladesmith.geometry.propeller import Propeller, smooth_blade
+        from bladesmith.operators import propeller as propeller_ops
 
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    start = time.perf_counter()
-    surface = demo_surface()
-    surface_object = surface_to_object(surface, "DemoBlade")
-    leading_edge = surface.iso_curve("u", 0.5)
-    curve_to_object(leading_edge, "DemoBladeMidChord")
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        steps = {}
+        start = time.perf_counter()
+        result = bpy.ops.bladesmith.add_propeller(preset=PRESET, smooth_tip=True)
+        steps["build (model, smoothing, display)"] = time.perf_counter() - start
+        if result != {"FINISHED"}:
+            print("add_propeller failed", file=sys.stderr)
+            return 1
+        root = next(o for o in bpy.context.scene.objects if getattr(o, "bladesmith_propeller", None)
+                    and o.bladesmith_propeller.is_propeller)
+        parts = propeller_ops.propeller_parts(root)
+        print(f"{root.name}: {len(parts)} objects ({sum(1 for k in parts if k[0] == 'blade')} blade surfaces "
+              f"including linked copies, hub)")
 
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    evaluated = surface_object.evaluated_get(depsgraph)
-    mesh = evaluated.to_mesh()
-    vertices = np.array([v.co[:] for v in mesh.vertices], dtype=np.float64)
-    evaluated.to_mesh_clear()
-    _, _, distances = closest_point_surface(surface, vertices)
-    print(
-        f"surface: {surface.shape[0]}x{surface.shape[1]} control points, degree "
-        f"({surface.degree_u}, {surface.degree_v}), rational; Blender mesh {len(vertices)} vertices, "
-        f"largest distance to the float64 surface {distances.max():.2e} m "
-        f"({distances.max() / surface.size():.1e} of the net size)"
-    )
+        # the numbers a user checks: a measured run of the same pipeline
+        definition = Propeller.from_toml(ROOT / "data" / "propellers" / "dtmb4119.toml")
+        t = time.perf_counter()
+        smoothed = smooth_blade(definition.build(), measure=True)
+        steps["smoothing with measurement"] = time.perf_counter() - t
+        report = smoothed.report
+        D = definition.diameter
+        cuts, knots = report["cuts"], report["knots"]
+        print(f"cuts: {cuts['tip']} tip, {cuts['leading_edge']} LE, {cuts['trailing_edge']} TE "
+              f"({cuts['smoothed']} smoothed), transition cut j = {report['transition_index']}; one knot vector for "
+              f"{knots['curves']} curves: {knots['n_control']} control points each")
+        dev = report["deviation_m"]
+        print(f"deviation from the section-table blade: {dev['max_outside']:.2e} m outside the smoothing zone "
+              f"(tolerance {report['tolerance_m']:.2e} m), {dev['max_inside']:.2e} m inside "
+              f"(bound {report['deviation_bound_inside_m']:.2e} m)")
+        gaps = [e["max_gap"] for e in report["shared_edges"]]
+        print(f"shared edges: {len(gaps)}, largest gap {max(gaps):.1e} m ({max(gaps) / D:.1e} D)")
 
-    blend = out / "demo.blend"
-    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
-    print(f"wrote {blend}")
-    from bladesmith.iges import curve_from_geometry, surface_from_geometry, write_iges
+        blend = out / "dtmb4119.blend"
+        t = time.perf_counter()
+        bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+        steps["save .blend"] = time.perf_counter() - t
+        print(f"wrote {blend}")
 
-    igs = out / "demo.igs"
-    write_iges(igs, [surface_from_geometry(surface, label="BLADE"), curve_from_geometry(leading_edge, label="MIDCHORD")],
-               units="m")
-    print(f"wrote {igs}")
-    print(f"done in {time.perf_counter() - start:.2f} s")
-    addon.unregister()
+        igs = out / "dtmb4119.igs"
+        t = time.perf_counter()
+        assert bpy.ops.export_scene.iges(filepath=str(igs), units="M") == {"FINISHED"}
+        steps["IGES export"] = time.perf_counter() - t
+        print(f"wrote {igs}")
+
+        for name, seconds in steps.items():
+            print(f"  {name:40s} {seconds:7.2f} s")
+    finally:
+        addon.unregister()
     return 0
 
 
