@@ -263,8 +263,27 @@ class BLADESMITH_PT_propeller_smoothing(_Sub, bpy.types.Panel):
         col = self.layout.column()
         col.use_property_split = True
         col.active = s.smooth_tip
-        for name in ops.SMOOTHING_FIELDS:
+        for name in SMOOTHING_UP_FRONT:
             col.prop(s, name)
+        col.prop(s, "show_overlay")
+
+
+#: The settings a user tunes (Hally's Δc, d_t, s_j and α); the rest are folded away.
+SMOOTHING_UP_FRONT = ("delta_c", "tip_smoothing_distance", "transition_s", "filter_strength")
+
+
+class BLADESMITH_PT_propeller_smoothing_advanced(_Sub, bpy.types.Panel):
+    bl_label = "Advanced"
+    bl_parent_id = "BLADESMITH_PT_propeller_smoothing"
+
+    def draw(self, context):
+        s = _root(context).bladesmith_propeller
+        col = self.layout.column()
+        col.use_property_split = True
+        col.active = s.smooth_tip
+        for name in ops.SMOOTHING_FIELDS:
+            if name not in SMOOTHING_UP_FRONT:
+                col.prop(s, name)
 
 
 class BLADESMITH_PT_propeller_display(_Sub, bpy.types.Panel):
@@ -293,6 +312,7 @@ _classes = (
     BLADESMITH_PT_propeller_section,
     BLADESMITH_PT_propeller_hub,
     BLADESMITH_PT_propeller_smoothing,
+    BLADESMITH_PT_propeller_smoothing_advanced,
     BLADESMITH_PT_propeller_display,
 )
 _register, _unregister = bpy.utils.register_classes_factory(_classes)

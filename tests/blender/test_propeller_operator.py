@@ -185,33 +185,28 @@ def test_unknown_preset_and_bad_settings_are_refused(scene):
 
 
 def test_smoothed_result_plugs_in_as_patches_with_copies(scene, monkeypatch):
-    """The smoothed path: whatever smooth_blade returns as surfaces becomes one object per
-    patch, each with its Z - 1 linked copies (a stand-in smoothing keeps this fast)."""
+    """The smoothed path: the five surfaces become one object per patch, each with its
+    Z - 1 linked copies; the settings reach the pipeline in metres (the operator's
+    lengths are fractions of D); switching smoothing off leaves one blade patch."""
     seen = {}
+    real = ops.smooth_blade
 
-    class FakeSmoothing:
-        @staticmethod
-        def smooth_blade(model, settings, progress=None, measure=True):
-            seen.update(settings)
-            progress("stage", 0.5)
-            display = blade_display_surface(model.blade, 1e-3 * model.definition.diameter)
-            S = display.surface
-            half = BSplineSurface(S.degree_u, S.degree_v, S.knots_u, S.knots_v, S.control_points * 0.5)
-            return type("Result", (), {"surfaces": (S, half)})()
+    def recording(model, settings, **kwargs):
+        seen.update(settings)
+        return real(model, settings, **kwargs)
 
-    monkeypatch.setattr(ops, "smooth_blade", FakeSmoothing.smooth_blade)
+    monkeypatch.setattr(ops, "smooth_blade", recording)
     assert bpy.ops.bladesmith.add_propeller(preset="dtmb4119", smooth_tip=True, delta_c=0.02) == {"FINISHED"}
     (root,) = roots()
     keys = set(parts(root))
-    assert {("blade", patch, k) for patch in (0, 1) for k in range(3)} <= keys
+    assert {("blade", patch, k) for patch in range(5) for k in range(3)} <= keys
     assert parts(root)[("blade", 1, 2)].data == parts(root)[("blade", 1, 0)].data
-    assert seen["delta_c"] == pytest.approx(0.02 * 0.3048)  # fractions of D in, metres out
-    # back to the unsmoothed blade: the second patch and its copies go away
+    assert seen["delta_c"] == pytest.approx(0.02 * 0.3048)
     before_curves = len(bpy.data.curves)
     root.bladesmith_propeller.smooth_tip = False
     assert not root.bladesmith_propeller.status_is_error
-    assert not any(key[1] == 1 for key in parts(root))
-    assert len(bpy.data.curves) == before_curves - 1
+    assert not any(key[1] >= 1 for key in parts(root) if key[0] == "blade")
+    assert len(bpy.data.curves) == before_curves - 4
 
 
 def test_smooth_tip_with_the_real_smoothing(scene):
@@ -451,6 +446,7 @@ def test_panels_draw_existing_properties_and_operators(root):
         panel.BLADESMITH_PT_propeller_section,
         panel.BLADESMITH_PT_propeller_hub,
         panel.BLADESMITH_PT_propeller_smoothing,
+        panel.BLADESMITH_PT_propeller_smoothing_advanced,
         panel.BLADESMITH_PT_propeller_display,
     ):
         fake = type("FakePanel", (), {"layout": RecordingLayout(calls)})()
@@ -461,9 +457,27 @@ def test_panels_draw_existing_properties_and_operators(root):
         cls.draw(fake, bpy.context)
     drawn = {name for kind, name in calls if kind == "prop"}
     assert {"blades", "diameter", "hub_diameter_ratio", "hand", "thickness_kind", "meanline",
-            "hub_nose_shape", "display_tolerance", "smooth_tip", *ops.SMOOTHING_FIELDS} <= drawn
+            "hub_nose_shape", "display_tolerance", "smooth_tip", "show_overlay", *ops.SMOOTHING_FIELDS} <= drawn
     assert {"radial", "thickness_table", "meanline_table"} <= {name for kind, name in calls if kind == "template_list"}
     # the radial list draws every column of a row
     row_calls = []
     panel.BLADESMITH_UL_radial.draw_item(None, bpy.context, RecordingLayout(row_calls), s, s.radial[0], 0, s, "radial_index")
     assert [name for _, name in row_calls] == list(ops.RADIAL_FIELDS)
+
+
+def test_smoothed_report_and_overlay(scene):
+    """The report gives the cuts, the knots and the deviation from the unsmoothed blade;
+    the optional overlay shows the cuts, c_LETE and the transition cut j, and goes away
+    when switched off."""
+    assert bpy.ops.bladesmith.add_propeller(preset="dtmb4119", smooth_tip=True, show_overlay=True) == {"FINISHED"}
+    (root,) = roots()
+    status = root.bladesmith_propeller.status
+    assert "tip" in status and "control points per curve" in status
+    assert "deviation from the unsmoothed blade" in status and "outside the smoothing zone" in status
+    overlays = {key[1]: obj for key, obj in parts(root).items() if key[0] == "overlay"}
+    assert set(overlays) == {0, 1, 2}
+    assert len(overlays[0].data.splines) == 42 * 3  # tip, LE and TE curves of DTMB 4119
+    assert len(overlays[1].data.splines) == 1 and len(overlays[2].data.splines) == 2
+    assert all(o.hide_render for o in overlays.values())
+    root.bladesmith_propeller.show_overlay = False
+    assert not any(key[0] == "overlay" for key in parts(root))
