@@ -5,7 +5,7 @@
 with G1 at S and SLSQP tangent magnitudes (§2, §4), the single-curve fit for comparison.
 ``blade``: common knots by averaging, skinning of the halves and of the single surface,
 root transition (§5.1), tolerance, continuity and fairness figures (§3, §5).
-``iges_export``: the mold surfaces (128) and parting lines (126) as IGES records.
+(The molds as IGES records: ``bladesmith.iges.mold``.)
 """
 from .blade import BladeMolds, StationReport, build_blade, common_knots, parting_line_continuity, root_transition
 from .definition import BladeDefinition, Station, blade_from_dict, circle_airfoil, load_blade, load_preset, preset_files

@@ -9,7 +9,7 @@ import pytest
 pytest.importorskip("OCP")
 
 from bladesmith.geometry.mold import build_blade, load_preset  # noqa: E402
-from bladesmith.geometry.mold.iges_export import write_molds  # noqa: E402
+from bladesmith.iges.mold import write_molds  # noqa: E402
 from bladesmith.iges import read_iges  # noqa: E402
 from bladesmith.iges.records import BSplineCurve126, BSplineSurface128  # noqa: E402
 from occ_support import is_valid, read_with_occ  # noqa: E402
@@ -74,3 +74,19 @@ def test_halves_sew_into_one_shell_open_only_at_root_and_tip(case):
         ends.add("root" if at_root else "tip")
     print(f"\nsewing: 1 shell, {sewing.NbFreeEdges()} free edges at {sorted(ends)}")
     assert ends == {"root", "tip"}
+
+
+def test_units_scale_the_coordinates(tmp_path):
+    """A file in millimetres holds coordinates 1000 times those in metres."""
+    from bladesmith.geometry.mold import build_blade, load_preset
+    from bladesmith.iges import read_iges
+
+    molds = build_blade(load_preset("S823_SMALL"), fairness=False)
+    metres, millimetres = tmp_path / "m.igs", tmp_path / "mm.igs"
+    write_molds(metres, molds, units="m")
+    write_molds(millimetres, molds, units="mm")
+    a = {r.label: r for r in read_iges(metres).roots}
+    b = {r.label: r for r in read_iges(millimetres).roots}
+    assert read_iges(millimetres).header.unit_name == "MM"
+    for label, record in a.items():
+        assert np.allclose(np.asarray(b[label].control_points), 1000.0 * np.asarray(record.control_points), rtol=1e-15)

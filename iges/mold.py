@@ -2,8 +2,10 @@
 (Hosseini & Moetakef-Imani 2016 §5: the molds are exchanged as IGES)."""
 from __future__ import annotations
 
-from ...iges import curve_from_geometry, surface_from_geometry, write_iges
-from .blade import BladeMolds
+from ..geometry.mold.blade import BladeMolds
+from .convert import curve_from_geometry, surface_from_geometry
+from .records import METRES_PER_UNIT
+from .writer import write_iges
 
 
 #: IGES entity labels (at most 8 characters) of the mold surfaces and parting lines.
@@ -15,15 +17,17 @@ LABELS = {
 }
 
 
-def mold_records(molds: BladeMolds, parting_lines: bool = True) -> list:
+def mold_records(molds: BladeMolds, parting_lines: bool = True, units: str = "m") -> list:
     """128 records of every mold surface (labelled with its name) and 126 records of the
-    parting lines."""
-    out = [surface_from_geometry(s, label=LABELS.get(name, "")) for name, s in molds.surfaces.items()]
+    parting lines, with coordinates in ``units`` (the model is in metres)."""
+    scale = 1.0 / METRES_PER_UNIT[units.lower()]
+    out = [surface_from_geometry(s, scale=scale, label=LABELS.get(name, "")) for name, s in molds.surfaces.items()]
     if parting_lines:
-        out += [curve_from_geometry(c, label=LABELS.get(name, "")) for name, c in molds.parting_lines.items()]
+        out += [curve_from_geometry(c, scale=scale, label=LABELS.get(name, ""))
+                for name, c in molds.parting_lines.items()]
     return out
 
 
 def write_molds(path, molds: BladeMolds, units: str = "m", parting_lines: bool = True) -> str:
-    """Write the molds to an IGES file atomically; returns what :func:`write_iges` returns."""
-    return write_iges(path, mold_records(molds, parting_lines), units=units)
+    """Write the molds to an IGES file atomically, coordinates in ``units``; returns the path."""
+    return write_iges(path, mold_records(molds, parting_lines, units), units=units)
