@@ -39,6 +39,7 @@ from ..iges import (
 )
 from ..iges.convert import surface_points, surface_range
 from .nurbs_objects import curve_to_object, object_to_geometry, surface_to_object
+from .progress import progress_callback
 
 #: Trimming curves of an imported 144 are approximated on the surface to this fraction of
 #: the surface's size (they have no exact model-space form when the file gives none).
@@ -136,7 +137,7 @@ def export_objects(objects, filepath: str, units: str = "M", progress=None) -> d
                 counts["curves"] += 1
         counts["objects"] += 1
         if progress:
-            progress(i + 1, len(objects))
+            progress((i + 1) / len(objects))
     if not records:
         raise BladesmithError("nothing to export: no NURBS surface or curve objects")
     write_iges(filepath, records, units=units.lower())
@@ -199,7 +200,7 @@ def import_file(filepath: str, collection, progress=None) -> dict:
                         created.append(curve_to_object(scaled(piece), name, collection))
                         counts["curves"] += 1
             if progress:
-                progress(i + 1, len(items))
+                progress((i + 1) / len(items))
     except BladesmithError:
         for obj in created:
             data = obj.data
@@ -209,19 +210,6 @@ def import_file(filepath: str, collection, progress=None) -> dict:
         raise
     counts["objects"] = created
     return counts
-
-
-class _Progress:
-    def __init__(self, context):
-        self.wm = context.window_manager
-
-    def __enter__(self):
-        self.wm.progress_begin(0, 100)
-        return lambda done, total: self.wm.progress_update(int(100 * done / max(total, 1)))
-
-    def __exit__(self, *exc):
-        self.wm.progress_end()
-        return False
 
 
 UNIT_ITEMS = [
@@ -245,12 +233,15 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
 
     def execute(self, context):
         objects = context.selected_objects if self.use_selection else context.scene.objects
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
         try:
-            with _Progress(context) as progress:
-                counts = export_objects(objects, self.filepath, self.units, progress)
+            counts = export_objects(objects, self.filepath, self.units, progress_callback(wm))
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
+        finally:
+            wm.progress_end()
         message = f"Wrote {counts['surfaces']} surfaces, {counts['trimmed']} trimmed surfaces and {counts['curves']} curves"
         if counts["propellers"]:
             message += (
@@ -272,12 +263,15 @@ class IMPORT_SCENE_OT_iges(bpy.types.Operator, ImportHelper):
     filter_glob: StringProperty(default="*.igs;*.iges", options={"HIDDEN"})
 
     def execute(self, context):
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
         try:
-            with _Progress(context) as progress:
-                counts = import_file(self.filepath, context.collection, progress)
+            counts = import_file(self.filepath, context.collection, progress_callback(wm))
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
+        finally:
+            wm.progress_end()
         message = f"Imported {counts['surfaces']} surfaces and {counts['curves']} curves"
         if counts["trimmed"]:
             message += (

@@ -60,6 +60,7 @@ from ..geometry.propeller import BladeSurface, Hub, Propeller, PropellerModel, d
 from ..geometry.propeller.definition import RADIAL_FIELDS
 from ..geometry.propeller.display import DISPLAY_TOLERANCE_FRACTION, blade_display_surface, hub_surface
 from . import nurbs_objects
+from .progress import progress_callback
 from .nurbs_objects import PROPERTY_KEY, order_from_degree
 
 #: The extension package (``bladesmith`` from a checkout, ``bl_ext.<repo>.bladesmith``
@@ -782,18 +783,6 @@ def load_definition(operator_definition: str, preset: str) -> Propeller:
     return Propeller.from_toml(preset_path(preset))
 
 
-class _Progress:
-    """window_manager.progress_* as geometry/'s plain progress callback (fraction 0..1)."""
-
-    def __init__(self, wm):
-        self.wm = wm
-
-    def __call__(self, *args) -> None:
-        # progress(fraction) or progress(stage, fraction)
-        fraction = float(args[-1]) if args else 0.0
-        self.wm.progress_update(int(100 * min(max(fraction, 0.0), 1.0)))
-
-
 # -- operators ------------------------------------------------------------------------------
 class BLADESMITH_OT_add_propeller(bpy.types.Operator):
     """Add a propeller from a definition file or a preset: the unsmoothed blade (or the tip-smoothed blade), its linked copies and the hub"""
@@ -844,7 +833,7 @@ class BLADESMITH_OT_add_propeller(bpy.types.Operator):
                 display_tolerance=self.display_tolerance,
                 smooth_tip=self.smooth_tip,
                 smoothing=smoothing,
-                progress=_Progress(wm),
+                progress=progress_callback(wm),
                 measure=True,
             )
             start = time.perf_counter()
@@ -1006,7 +995,7 @@ class BLADESMITH_OT_load_propeller_definition(bpy.types.Operator):
                 display_tolerance=settings.display_tolerance,
                 smooth_tip=settings.smooth_tip,
                 smoothing=smoothing,
-                progress=_Progress(wm),
+                progress=progress_callback(wm),
             )
             start = time.perf_counter()
             definition_to_settings(settings, propeller)

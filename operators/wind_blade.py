@@ -55,6 +55,7 @@ from ..geometry.nurbs import BSplineCurve
 from ..geometry.propeller import dumps_toml
 from ..iges import surface_from_geometry, write_iges
 from . import nurbs_objects
+from .progress import progress_callback
 from .propeller import write_surface
 
 #: Custom property naming a child's part (a key of BladeMolds.surfaces / parting_lines, or "single").
@@ -377,16 +378,6 @@ def create_wind_blade(context, molds: BladeMolds, mold_halves: bool, seconds: fl
     return root
 
 
-class _Progress:
-    """window_manager.progress_* as geometry/'s plain progress callback (fraction 0..1)."""
-
-    def __init__(self, wm):
-        self.wm = wm
-
-    def __call__(self, fraction) -> None:
-        self.wm.progress_update(int(100 * min(max(float(fraction), 0.0), 1.0)))
-
-
 def _override(defn: BladeDefinition, control_points: int, tolerance: float) -> BladeDefinition:
     """``defn`` with the operator's control-point count and tolerance (0 = keep)."""
     if not control_points and not tolerance:
@@ -458,7 +449,7 @@ class BLADESMITH_OT_add_wind_blade(bpy.types.Operator):
             tolerance = _typed(self.tolerance)  # the float32 property as typed
             check_fit_settings(self.control_points, tolerance)
             defn = _override(load_definition(self.definition, self._preset_name()), self.control_points, tolerance)
-            molds = compute_molds(defn, fairness=self.fairness, progress=_Progress(wm))
+            molds = compute_molds(defn, fairness=self.fairness, progress=progress_callback(wm))
             root = create_wind_blade(context, molds, self.mold_halves, time.perf_counter() - start)
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
@@ -474,6 +465,20 @@ class _OnRoot:
     def poll(cls, context):
         return context.mode == "OBJECT" and find_root(context.active_object) is not None
 
+    def _regenerate(self, context, **options):
+        """Regenerate the active wind blade with progress; report a failure."""
+        root = find_root(context.active_object)
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        try:
+            ok = regenerate(root, progress=progress_callback(wm), **options)
+        finally:
+            wm.progress_end()
+        if not ok:
+            self.report({"ERROR"}, root.bladesmith_wind_blade.status)
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
 
 class BLADESMITH_OT_regenerate_wind_blade(_OnRoot, bpy.types.Operator):
     """Rebuild the active wind blade from its settings, starting the fit from the set control-point count"""
@@ -483,17 +488,7 @@ class BLADESMITH_OT_regenerate_wind_blade(_OnRoot, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     def execute(self, context):
-        root = find_root(context.active_object)
-        wm = context.window_manager
-        wm.progress_begin(0, 100)
-        try:
-            ok = regenerate(root, fresh=True, progress=_Progress(wm))
-        finally:
-            wm.progress_end()
-        if not ok:
-            self.report({"ERROR"}, root.bladesmith_wind_blade.status)
-            return {"CANCELLED"}
-        return {"FINISHED"}
+        return self._regenerate(context, fresh=True)
 
 
 class BLADESMITH_OT_wind_blade_fairness(_OnRoot, bpy.types.Operator):
@@ -504,17 +499,7 @@ class BLADESMITH_OT_wind_blade_fairness(_OnRoot, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     def execute(self, context):
-        root = find_root(context.active_object)
-        wm = context.window_manager
-        wm.progress_begin(0, 100)
-        try:
-            ok = regenerate(root, fairness=True, progress=_Progress(wm))
-        finally:
-            wm.progress_end()
-        if not ok:
-            self.report({"ERROR"}, root.bladesmith_wind_blade.status)
-            return {"CANCELLED"}
-        return {"FINISHED"}
+        return self._regenerate(context, fairness=True)
 
 
 class BLADESMITH_OT_wind_blade_station_add(_OnRoot, bpy.types.Operator):
@@ -616,7 +601,7 @@ class BLADESMITH_OT_export_wind_blade_iges(_OnRoot, bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
-            export_molds(root.bladesmith_wind_blade, path, progress=_Progress(wm))
+            export_molds(root.bladesmith_wind_blade, path, progress=progress_callback(wm))
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
