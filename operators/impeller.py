@@ -14,7 +14,7 @@ import tomllib
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, EnumProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, StringProperty
 
 from ..geometry.compressor import ImpellerDefinition, blade_net, distribution, dumps_toml
 from ..geometry.compressor.export import impeller_surfaces

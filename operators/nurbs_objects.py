@@ -324,32 +324,43 @@ def _link(obj, collection) -> None:
     target.objects.link(obj)
 
 
-def curve_to_object(curve: BSplineCurve, name: str, collection=None, resolution: int = DEFAULT_CURVE_RESOLUTION):
-    """A CURVE object showing ``curve`` exactly (Bezier form, endpoint + Bezier knot mode).
-
-    2-D curves are placed at z = 0. ``resolution``: Blender's evaluated points per
-    control-point interval. The exact float64 curve is stored on the object
+def write_curve(obj, curve: BSplineCurve, resolution: int = DEFAULT_CURVE_RESOLUTION) -> None:
+    """Show ``curve`` exactly in the CURVE object ``obj`` (Bezier form, endpoint + Bezier
+    knot mode), reusing its curve data: only the points change while the Bezier form keeps
+    its size. 2-D curves are placed at z = 0. Stores the exact float64 curve on ``obj``
     (:func:`stored_geometry`). Raises :class:`GeometryError` for degrees above
-    :data:`MAX_DEGREE` or dimensions above 3.
-    """
+    :data:`MAX_DEGREE` or dimensions above 3."""
     order = order_from_degree(curve.degree)
     bezier = _bezier_operations().to_bezier_form(curve)
-    rows = _homogeneous_3d(bezier.control_points, bezier.weights, "curve")
+    rows = _homogeneous_3d(bezier.control_points, bezier.weights, obj.name)
+    splines = obj.data.splines
+    if not (len(splines) == 1 and splines[0].type == "NURBS" and len(splines[0].points) == len(rows)):
+        splines.clear()
+        spline = splines.new("NURBS")
+        spline.points.add(len(rows) - 1)
+        spline.use_endpoint_u = spline.use_bezier_u = True
+        spline.use_cyclic_u = False
+    spline = splines[0]
+    spline.points.foreach_set("co", rows.astype(np.float32).ravel())
+    if spline.order_u != order:
+        spline.order_u = order
+        if spline.order_u != order:
+            raise GeometryError(f"{obj.name}: Blender set order {spline.order_u} instead of {order}")
+    if spline.resolution_u != int(resolution):
+        spline.resolution_u = int(resolution)
+    obj.data.update_tag()
+    _store(obj, curve)
+
+
+def curve_to_object(curve: BSplineCurve, name: str, collection=None, resolution: int = DEFAULT_CURVE_RESOLUTION):
+    """A new CURVE object showing ``curve`` exactly (:func:`write_curve`), linked to
+    ``collection`` (the scene collection by default)."""
+    order_from_degree(curve.degree)
     data = _new_curve_data(name, "CURVE")
     obj = bpy.data.objects.new(name, data)
     try:
-        spline = data.splines.new("NURBS")
-        spline.points.add(len(rows) - 1)
-        spline.points.foreach_set("co", rows.astype(np.float32).ravel())
-        spline.order_u = order
-        spline.use_endpoint_u = True
-        spline.use_bezier_u = True
-        spline.use_cyclic_u = False
-        spline.resolution_u = int(resolution)
-        if spline.order_u != order:
-            raise GeometryError(f"Blender set order {spline.order_u} instead of {order}")
+        write_curve(obj, curve, resolution)
         _link(obj, collection)
-        _store(obj, curve)
     except BaseException:
         bpy.data.objects.remove(obj)
         bpy.data.curves.remove(data)
@@ -416,58 +427,100 @@ def _midpoint_column(homogeneous: np.ndarray) -> np.ndarray:
     return Pw
 
 
-def surface_to_object(
-    surface: BSplineSurface, name: str, collection=None, resolution=DEFAULT_SURFACE_RESOLUTION
-):
-    """A SURFACE object showing ``surface`` exactly (Bezier form, endpoint + Bezier knots).
+def _shows(obj, surface: BSplineSurface, resolution: tuple[int, int]) -> bool:
+    """Whether ``obj`` already shows exactly ``surface``, unedited and at this resolution."""
+    stored = stored_geometry(obj)
+    if not stored or not isinstance(stored[0], BSplineSurface):
+        return False
+    old = stored[0]
+    spline = obj.data.splines[0]
+    same_weights = (old.weights is None and surface.weights is None) or (
+        old.weights is not None and surface.weights is not None and np.array_equal(old.weights, surface.weights))
+    return (
+        (spline.resolution_u, spline.resolution_v) == resolution
+        and (old.degree_u, old.degree_v) == (surface.degree_u, surface.degree_v)
+        and np.array_equal(old.knots_u, surface.knots_u)
+        and np.array_equal(old.knots_v, surface.knots_v)
+        and np.array_equal(old.control_points, surface.control_points)
+        and same_weights
+    )
 
-    The surface's u direction is Blender's u. ``resolution``: Blender's evaluated points per
-    control point, one int or (u, v). The exact float64 surface is stored on the object
-    (:func:`stored_geometry`). Works in background mode; the active object, selection and
-    mode are restored afterwards. Raises :class:`GeometryError` for degrees above
-    :data:`MAX_DEGREE` or dimensions above 3.
+
+def write_surface(obj, surface: BSplineSurface, resolution=DEFAULT_SURFACE_RESOLUTION) -> bool:
+    """Show ``surface`` exactly in the SURFACE object ``obj`` (Bezier form, endpoint +
+    Bezier knot modes, order = degree + 1), reusing its curve data.
+
+    The surface's u direction is Blender's u. ``resolution``: Blender's evaluated points
+    per control point, one int or (u, v). When the data holds one spline whose net has the
+    size of the new Bezier net, only the control points are rewritten; otherwise rows of
+    points are joined into one surface spline with ``make_segment`` in edit mode (works in
+    background mode; the active object, selection and mode are restored). Nothing is
+    written when ``obj`` already shows ``surface``. Stores the exact float64 surface on
+    ``obj`` (:func:`stored_geometry`). Returns True when the net was rebuilt. Raises
+    :class:`GeometryError` for degrees above :data:`MAX_DEGREE` or dimensions above 3.
     """
-    order_u = order_from_degree(surface.degree_u)
-    order_v = order_from_degree(surface.degree_v)
-    res_u, res_v = _resolution_pair(resolution)
+    res = _resolution_pair(resolution)
+    if _shows(obj, surface, res):
+        return False
+    order_u, order_v = order_from_degree(surface.degree_u), order_from_degree(surface.degree_v)
     bezier = _bezier_operations().surface_to_bezier_form(surface)
-    net = _homogeneous_3d(bezier.control_points, bezier.weights, "surface")
+    net = _homogeneous_3d(bezier.control_points, bezier.weights, obj.name)
     if net.shape[1] == 2:
         net = _midpoint_column(net)  # make_segment does not join rows of two points
     nu, nv = net.shape[:2]
-    data = _new_curve_data(name, "SURFACE")
-    obj = bpy.data.objects.new(name, data)
-    try:
+    data = obj.data
+    splines = data.splines
+    rebuild = not (len(splines) == 1 and (splines[0].point_count_u, splines[0].point_count_v) == (nu, nv))
+    if rebuild:
+        splines.clear()
+        # low resolution before joining: Blender evaluates the net in edit mode, and at the
+        # default resolution (12) a large net costs half a second there
+        data.resolution_u, data.resolution_v = res
         for i in range(nu):
-            row = data.splines.new("NURBS")
+            row = splines.new("NURBS")
+            row.resolution_u, row.resolution_v = res
             row.points.add(nv - 1)
             row.points.foreach_set("co", net[i].astype(np.float32).ravel())
+            # selected here rather than by an operator: every bpy.ops call re-evaluates the
+            # view layer twice
+            row.points.foreach_set("select", np.ones(nv, dtype=bool))
         with _editing(obj):
-            bpy.ops.curve.select_all(action="SELECT")
             bpy.ops.curve.make_segment()
-        if len(data.splines) != 1:
-            raise GeometryError(f"Blender joined the {nu} rows into {len(data.splines)} splines, not one")
-        spline = data.splines[0]
-        if (spline.point_count_u, spline.point_count_v) != (nu, nv):
-            raise GeometryError(
-                f"Blender made a {spline.point_count_u} x {spline.point_count_v} net, expected {nu} x {nv}"
-            )
-        # point k of a surface spline is (u = k % nu, v = k // nu); rewrite them all so the
-        # result does not depend on the order make_segment joined the rows in
-        spline.points.foreach_set("co", net.transpose(1, 0, 2).astype(np.float32).ravel())
+        if len(splines) != 1 or (splines[0].point_count_u, splines[0].point_count_v) != (nu, nv):
+            raise GeometryError(f"{obj.name}: Blender did not join the {nu} rows into one {nu} x {nv} net")
+    spline = splines[0]
+    # point k of a surface spline is (u = k % nu, v = k // nu); rewrite them all so the
+    # result does not depend on the order make_segment joined the rows in
+    spline.points.foreach_set("co", net.transpose(1, 0, 2).astype(np.float32).ravel())
+    if rebuild:
         spline.points.foreach_set("select", np.zeros(nu * nv, dtype=bool))
-        spline.order_u, spline.order_v = order_u, order_v
         spline.use_endpoint_u = spline.use_endpoint_v = True
         spline.use_bezier_u = spline.use_bezier_v = True
         spline.use_cyclic_u = spline.use_cyclic_v = False
-        spline.resolution_u, spline.resolution_v = res_u, res_v
         spline.use_smooth = True
+    if (spline.order_u, spline.order_v) != (order_u, order_v):
+        spline.order_u, spline.order_v = order_u, order_v
         if (spline.order_u, spline.order_v) != (order_u, order_v):
             raise GeometryError(
-                f"Blender set orders ({spline.order_u}, {spline.order_v}) instead of ({order_u}, {order_v})"
+                f"{obj.name}: Blender set orders ({spline.order_u}, {spline.order_v}) instead of ({order_u}, {order_v})"
             )
+    if (spline.resolution_u, spline.resolution_v) != res:
+        spline.resolution_u, spline.resolution_v = res
+    data.update_tag()
+    _store(obj, surface)
+    return rebuild
+
+
+def surface_to_object(surface: BSplineSurface, name: str, collection=None, resolution=DEFAULT_SURFACE_RESOLUTION):
+    """A new SURFACE object showing ``surface`` exactly (:func:`write_surface`), linked to
+    ``collection`` (the scene collection by default)."""
+    order_from_degree(surface.degree_u)
+    order_from_degree(surface.degree_v)
+    data = _new_curve_data(name, "SURFACE")
+    obj = bpy.data.objects.new(name, data)
+    try:
+        write_surface(obj, surface, resolution)
         _link(obj, collection)
-        _store(obj, surface)
     except BaseException:
         bpy.data.objects.remove(obj)
         bpy.data.curves.remove(data)

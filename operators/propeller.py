@@ -55,13 +55,12 @@ import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from ..geometry.errors import BladesmithError, DefinitionError
-from ..geometry.nurbs import BSplineSurface, surface_to_bezier_form
+from ..geometry.nurbs import BSplineSurface
 from ..geometry.propeller import BladeSurface, Hub, Propeller, PropellerModel, dumps_toml, smooth_blade
 from ..geometry.propeller.definition import RADIAL_FIELDS
 from ..geometry.propeller.display import DISPLAY_TOLERANCE_FRACTION, blade_display_surface, hub_surface
-from . import nurbs_objects
 from .progress import progress_callback
-from .nurbs_objects import PROPERTY_KEY, order_from_degree
+from .nurbs_objects import PROPERTY_KEY, write_surface
 
 #: The extension package (``bladesmith`` from a checkout, ``bl_ext.<repo>.bladesmith``
 #: when installed).
@@ -467,79 +466,6 @@ def smoothing_summary(smoothed) -> str:
 
 
 # -- writing surfaces into objects ----------------------------------------------------------
-def _shows(obj, surface: BSplineSurface, resolution: int) -> bool:
-    """Whether ``obj`` already shows exactly ``surface`` (e.g. the hub when a blade value
-    changed), unedited and at this resolution."""
-    stored = nurbs_objects.stored_geometry(obj)
-    if not stored or not isinstance(stored[0], BSplineSurface):
-        return False
-    old = stored[0]
-    spline = obj.data.splines[0]
-    return (
-        (spline.resolution_u, spline.resolution_v) == (resolution, resolution)
-        and (old.degree_u, old.degree_v) == (surface.degree_u, surface.degree_v)
-        and np.array_equal(old.knots_u, surface.knots_u)
-        and np.array_equal(old.knots_v, surface.knots_v)
-        and np.array_equal(old.control_points, surface.control_points)
-        and ((old.weights is None and surface.weights is None)
-             or (old.weights is not None and surface.weights is not None and np.array_equal(old.weights, surface.weights)))
-    )
-
-
-def write_surface(obj, surface: BSplineSurface, resolution: int) -> bool:
-    """Show ``surface`` exactly in the SURFACE object ``obj``, reusing its curve data.
-
-    When the data holds one spline whose net has the size of the new Bezier net, only the
-    control points are rewritten; otherwise the splines are rebuilt (rows joined with
-    ``make_segment`` in edit mode, as :func:`.nurbs_objects.surface_to_object` does).
-    Stores the exact surface on ``obj``. Nothing is written when ``obj`` already shows
-    ``surface``. Returns True when the net was rebuilt.
-    """
-    if _shows(obj, surface, resolution):
-        return False
-    order_u, order_v = order_from_degree(surface.degree_u), order_from_degree(surface.degree_v)
-    bezier = surface_to_bezier_form(surface)
-    net = nurbs_objects._homogeneous_3d(bezier.control_points, bezier.weights, obj.name)
-    if net.shape[1] == 2:
-        net = nurbs_objects._midpoint_column(net)
-    nu, nv = net.shape[:2]
-    data = obj.data
-    splines = data.splines
-    rebuild = not (len(splines) == 1 and (splines[0].point_count_u, splines[0].point_count_v) == (nu, nv))
-    if rebuild:
-        splines.clear()
-        # low resolution before joining: Blender evaluates the net in edit mode, and at the
-        # default resolution (12) a large net costs half a second there
-        data.resolution_u = data.resolution_v = resolution
-        for i in range(nu):
-            row = splines.new("NURBS")
-            row.resolution_u = row.resolution_v = resolution
-            row.points.add(nv - 1)
-            row.points.foreach_set("co", net[i].astype(np.float32).ravel())
-            # selected here rather than by an operator: every bpy.ops call re-evaluates
-            # the view layer twice
-            row.points.foreach_set("select", np.ones(nv, dtype=bool))
-        with nurbs_objects._editing(obj):
-            bpy.ops.curve.make_segment()
-        if len(splines) != 1 or (splines[0].point_count_u, splines[0].point_count_v) != (nu, nv):
-            raise BladesmithError(f"{obj.name}: Blender did not join the {nu} rows into one {nu} x {nv} net")
-    spline = splines[0]
-    spline.points.foreach_set("co", net.transpose(1, 0, 2).astype(np.float32).ravel())
-    if rebuild:
-        spline.points.foreach_set("select", np.zeros(nu * nv, dtype=bool))
-        spline.use_endpoint_u = spline.use_endpoint_v = True
-        spline.use_bezier_u = spline.use_bezier_v = True
-        spline.use_cyclic_u = spline.use_cyclic_v = False
-        spline.use_smooth = True
-    if (spline.order_u, spline.order_v) != (order_u, order_v):
-        spline.order_u, spline.order_v = order_u, order_v
-    if (spline.resolution_u, spline.resolution_v) != (resolution, resolution):
-        spline.resolution_u = spline.resolution_v = resolution
-    data.update_tag()
-    nurbs_objects._store(obj, surface)
-    return rebuild
-
-
 def _part(obj) -> tuple[str, int, int] | None:
     if obj.get(PART_KEY) is None:
         return None

@@ -56,7 +56,7 @@ from ..geometry.propeller import dumps_toml
 from ..iges import surface_from_geometry, write_iges
 from . import nurbs_objects
 from .progress import progress_callback
-from .propeller import write_surface
+from .nurbs_objects import write_curve, write_surface
 
 #: Custom property naming a child's part (a key of BladeMolds.surfaces / parting_lines, or "single").
 PART_KEY = "bladesmith_mold_part"
@@ -189,29 +189,6 @@ def _base_dir(defn: BladeDefinition) -> str:
 
 
 # -- writing the molds into objects -----------------------------------------------------------
-def write_curve(obj, curve: BSplineCurve, resolution: int = CURVE_RESOLUTION) -> None:
-    """Show ``curve`` exactly in the CURVE object ``obj``, reusing its curve data (only the
-    points change while the Bezier form keeps its size); stores the exact curve."""
-    order = nurbs_objects.order_from_degree(curve.degree)
-    bezier = nurbs_objects._bezier_operations().to_bezier_form(curve)
-    rows = nurbs_objects._homogeneous_3d(bezier.control_points, bezier.weights, obj.name)
-    splines = obj.data.splines
-    if not (len(splines) == 1 and splines[0].type == "NURBS" and len(splines[0].points) == len(rows)):
-        splines.clear()
-        spline = splines.new("NURBS")
-        spline.points.add(len(rows) - 1)
-        spline.use_endpoint_u = spline.use_bezier_u = True
-        spline.use_cyclic_u = False
-    spline = splines[0]
-    spline.points.foreach_set("co", rows.astype(np.float32).ravel())
-    if spline.order_u != order:
-        spline.order_u = order
-    if spline.resolution_u != resolution:
-        spline.resolution_u = resolution
-    obj.data.update_tag()
-    nurbs_objects._store(obj, curve)
-
-
 def mold_parts(root) -> dict:
     """Children of a wind-blade root by part name."""
     return {str(child[PART_KEY]): child for child in root.children if child.get(PART_KEY) is not None}
@@ -268,7 +245,7 @@ def show_molds(root, molds: BladeMolds, mold_halves: bool) -> dict:
         if obj is None:
             parts[name] = _new_child(root, entity, f"{root.name} {part_label(name)}", name)
         elif is_curve:
-            write_curve(obj, entity)
+            write_curve(obj, entity, CURVE_RESOLUTION)
         else:
             write_surface(obj, entity, SURFACE_RESOLUTION)
     root.empty_display_size = 0.1 * molds.definition.stations[-1].r

@@ -179,7 +179,6 @@ def _unit(angle_deg: float) -> np.ndarray:
 
 def _wall_string(wall: WallSkeleton, degrees, which: str, path: str | None) -> BezierString:
     C = np.asarray(wall.corners, dtype=float)
-    n = len(degrees)
     angles = np.array(wall.angles, dtype=float)
     # angles of straight patches fix the corner angles next to them
     for j, deg in enumerate(degrees):

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import BladesmithError, GeometryError
-from ..nurbs import BSplineCurve, BSplineSurface, interpolate, skin
+from ..nurbs import BSplineSurface, interpolate, skin
 from ..nurbs.fitting import approximation_knots, parameterize
 from ..nurbs.projection import closest_point_curve
 from ..nurbs.skinning import skin_parameters

@@ -303,7 +303,6 @@ class BSplineSurface:
         """
         us = check_parameters(np.ravel(us), self.knots_u, self.degree_u, "u")
         vs = check_parameters(np.ravel(vs), self.knots_v, self.degree_v, "v")
-        p, q = self.degree_u, self.degree_v
         Mu = self.basis_matrix_u(us)  # (len(us), nu)
         Mv = self.basis_matrix_v(vs)  # (len(vs), nv)
         net = self._net()

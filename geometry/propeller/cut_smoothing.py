@@ -40,7 +40,7 @@ from scipy.interpolate import make_interp_spline
 from scipy.optimize import brentq
 
 from ..errors import GeometryError
-from .corners import SplineCurve, blade_derivatives, blade_points
+from .corners import SplineCurve, blade_points
 
 #: Largest filter strength α for which the explicit fourth-difference filter is stable.
 MAX_STABLE_FILTER_STRENGTH = 0.75

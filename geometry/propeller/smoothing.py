@@ -359,7 +359,6 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
     curves = build_edge_curves(blade, corners, sides, settings)
     lap("cuts_and_edge_curves")
     tol = settings.tolerance * R
-    fam = {"leading_edge": curves.leading, "trailing_edge": curves.trailing, "tip": curves.tip}
     # one knot sequence for every distinct curve (c_11, c_12 are shared by two families)
     unique = curves.leading + curves.trailing[:-1] + curves.tip[1:-1]
     knot_report: dict = {}
