@@ -1,0 +1,777 @@
+"""Curvature-based smoothing of plane cubic B-spline curves: smooth2D and smoothfoil.
+
+Hvid, S. L. (1993), *Curvature based smoothing of plane cubic B-spline curves*, DTU
+Department of Fluid Mechanics, AFM 93-08.
+
+The algorithm (§3.2, steps 1–5), on N = n+1 points r_0..r_n redistributed along the input
+curve (§3.2 "Conditioning the algorithm", distributions of §3.3):
+
+1. Interpolate r_i by the cubic B-spline with knots at their parameters u_i (Eq. 2.1;
+   control points d_{-1}..d_{n+1}, here P_0..P_{n+2}; d_{-1} = r_0, d_{n+1} = r_n; the
+   end tangents from finite differences of order ``end_derivative_order`` — the jobcard's
+   "iorder", §3.4). Curvature κ_i at the knots (Eq. 2.10) from the spline's own first and
+   second derivatives, which are linear in the control points: no finite differences.
+2. Smooth κ_i into the target κ*_i: the ad hoc smoother κ*_i = (κ_{i−1} + κ_i + κ_{i+1})/3
+   over ``passes`` passes, or a linear least-squares spline fit (§3.2); smoothing type 2
+   keeps the maximum (the leading-edge value of an airfoil, jobcard "smttype", §3.4).
+3. J_ij = ∂κ_i/∂(ε n_j): displacement of d_j along the curve normal n_j at r_j, by finite
+   differences. Moving d_j changes κ only at u_{j−1}, u_j, u_{j+1} (§2, local control), so
+   J is tridiagonal; the three diagonals come from three perturbed evaluations (every
+   third vertex moved at once).
+4. Solve J δ = κ* − κ with ``scipy.linalg.solve_banded``.
+5. d_j ← d_j + δ_j n_j; repeat 3–5 (a secant method, §3.2) until Σ|κ − κ*| <= tolf or
+   Σ|δ| <= tolx (the jobcard's "tolf"/"tolx"; iteration printout of §3.4), at most
+   ``max_iterations`` ("ntrial") times.
+
+smoothfoil (§3.3 "Airfoil preparation", §3.2.1) works at unit chord with a sharp trailing
+edge: blunt trailing edges are extended along the end tangents to a point, scaled to unit
+chord, smoothed, scaled back and cut at the original trailing-edge ends. The smoothed
+airfoil is rescaled to the original chord (§3.2 last paragraph). smooth2D uses the
+curvature-weighted distribution (§3.3) and works at unit reference length (the bounding-box
+diagonal), so tolerances mean the same for every curve.
+
+Deviation is reported as Hvid's ds (§3.2.1: distance at equal parameters, an upper bound)
+and as the true distance between the curves (closest points, both ways), and as the
+distance of the input data points from the smoothed curve.
+"""
+from __future__ import annotations
+
+import pathlib
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from scipy.interpolate import make_smoothing_spline
+from scipy.linalg import solve_banded
+
+from ..files import atomic_write
+from ..errors import DefinitionError, GeometryError
+from ..nurbs import BSplineCurve, closest_point_curve, split
+from ..nurbs.basis import basis_function_derivatives, basis_functions, find_span
+from ..sections.airfoil_file import Airfoil
+from .curvature import arclength_table, curvature_at, derivatives, params_at_arclength, span_samples
+from .distributions import DistributionReport, PolynomialDistribution, curvature_fractions, distribution_report
+
+# -- named tolerances and defaults (jobcard of Hvid 1993, Appendix) ---------------------
+#: Finite-difference displacement ε of step 3, relative to the reference length (unit
+#: chord): small against the 1e-4 c scale of the corrections, large against round-off.
+JACOBIAN_STEP = 1e-7
+
+#: A Newton step whose largest displacement exceeds this fraction of the reference length,
+#: or a residual that grows by more than :data:`DIVERGENCE_FACTOR` over the first one,
+#: counts as divergence: the iteration stops and reports it.
+MAX_STEP = 0.05
+DIVERGENCE_FACTOR = 1e3
+
+#: Trailing-edge gap (fraction of chord) below which an airfoil counts as sharp.
+SHARP_TE_TOL = 1e-9
+
+#: The leading edge must lie inside the outline by this many points from either end.
+MIN_POINTS_PER_SIDE = 3
+
+#: Samples per knot span when measuring the true deviation between curves and extremes
+#: of curvature.
+DEVIATION_SAMPLES_PER_SPAN = 6
+
+#: Weight of the kept maximum in the least-squares smoother of smoothing type 2 (relative
+#: to 1 for every other point): large enough to pin the fit to the value.
+KEEP_MAX_WEIGHT = 1e6
+
+#: Newton steps used to locate the leading edge (farthest point from the trailing edge).
+LEADING_EDGE_NEWTON_STEPS = 8
+
+SMOOTHERS = ("ad_hoc", "least_squares")
+SMOOTHING_TYPES = (1, 2)
+
+Progress = Callable[[int, int], None]
+
+
+class SmoothingNotConverged(GeometryError):
+    """The Newton/secant iteration of Hvid (1993) §3.2 did not meet tolx/tolf.
+
+    ``history``: tuple of (Σ|κ − κ*|, Σ|δ|) per iteration; ``reason``: why it stopped.
+    The message carries the residual history.
+    """
+
+    def __init__(self, message: str, history, reason: str):
+        self.history = tuple(history)
+        self.reason = reason
+        lines = [message, f"stopped: {reason}"]
+        lines += [f"iteration {k}: residual {f:.6e}  step {x:.6e}" for k, (f, x) in enumerate(self.history, 1)]
+        super().__init__("\n".join(lines))
+
+
+@dataclass(frozen=True)
+class SmoothingSettings:
+    """Parameters of the smoother, named after Hvid's jobcard (1993, Appendix and §3.4).
+
+    smoothing_points: nsmooth, points (knots) of the smoothing spline.
+    output_points: np, points of the final layout written out.
+    max_iterations: ntrial. tolx: tolerance on Σ|δ| between iterations (reference length 1).
+    tolf: tolerance on Σ|κ − κ*| (curvature at reference length 1).
+    smoothing_type: smttype, 1 smooths every point, 2 keeps the maximum |κ| value.
+    smoother: "ad_hoc" (3-point mean, §3.2) or "least_squares" (cubic spline fit).
+    passes: passes of the ad hoc smoother (the paper's fx66 run uses 4, §3.2.1).
+    end_derivative_order: iorder, 2 or 3: order of the finite-difference end tangents.
+    smoothing_weight: λ of the least-squares smoother (penalised cubic spline in the
+    point index, scipy ``make_smoothing_spline``); 0 chooses λ by generalised
+    cross-validation.
+    """
+
+    smoothing_points: int = 180
+    output_points: int = 150
+    max_iterations: int = 10
+    tolx: float = 1e-10
+    tolf: float = 1e-9
+    smoothing_type: int = 2
+    smoother: str = "ad_hoc"
+    passes: int = 4
+    end_derivative_order: int = 2
+    smoothing_weight: float = 10.0
+
+    def __post_init__(self):
+        def need(ok: bool, name: str, what: str):
+            if not ok:
+                raise DefinitionError(f"{what}, got {getattr(self, name)!r}", field=name)
+
+        need(int(self.smoothing_points) >= 8, "smoothing_points", "nsmooth must be >= 8")
+        need(int(self.output_points) >= 4, "output_points", "np must be >= 4")
+        need(int(self.max_iterations) >= 1, "max_iterations", "ntrial must be >= 1")
+        need(np.isfinite(self.tolx) and self.tolx >= 0, "tolx", "tolx must be >= 0")
+        need(np.isfinite(self.tolf) and self.tolf >= 0, "tolf", "tolf must be >= 0")
+        need(self.smoothing_type in SMOOTHING_TYPES, "smoothing_type", f"smoothing type must be one of {SMOOTHING_TYPES}")
+        need(self.smoother in SMOOTHERS, "smoother", f"smoother must be one of {SMOOTHERS}")
+        need(int(self.passes) >= 0, "passes", "passes must be >= 0")
+        need(self.end_derivative_order in (2, 3), "end_derivative_order", "iorder must be 2 or 3")
+        need(np.isfinite(self.smoothing_weight) and self.smoothing_weight >= 0, "smoothing_weight", "smoothing_weight must be >= 0")
+
+
+# =======================================================================================
+# step 1: interpolation with knots at the data parameters, curvature at the knots
+# =======================================================================================
+def end_derivative(params: np.ndarray, points: np.ndarray, order: int, at_end: bool = False) -> np.ndarray:
+    """dr/du at the first (or last) point from the polynomial through ``order`` + 1 end
+    points: a one-sided finite difference of order ``order`` (Hvid's iorder, §3.4)."""
+    k = order + 1
+    if at_end:
+        x, y = params[::-1][:k], points[::-1][:k]
+    else:
+        x, y = params[:k], points[:k]
+    x0 = x[0]
+    w = np.empty(k)
+    w[0] = np.sum(1.0 / (x0 - x[1:]))
+    for j in range(1, k):
+        others = np.delete(np.arange(k), j)
+        num = np.prod(x0 - x[others[others != 0]])
+        den = np.prod(x[j] - x[others])
+        w[j] = num / den
+    return w @ y
+
+
+def interpolate_at_knots(points, params, start_derivative, end_derivative_) -> BSplineCurve:
+    """Cubic B-spline through r_i at u_i with knots at the u_i (Hvid 1993 Eq. 2.1) and the
+    end derivatives prescribed: knots u_0^4, u_1..u_{n−1}, u_n^4; n+3 control points with
+    P_0 = r_0 and P_{n+2} = r_n. The system is banded (solve_banded)."""
+    Q = np.asarray(points, dtype=np.float64)
+    u = np.asarray(params, dtype=np.float64)
+    n = Q.shape[0] - 1
+    U = np.concatenate([np.full(4, u[0]), u[1:-1], np.full(4, u[-1])])
+    span = find_span(U, 3, u)
+    N = basis_functions(U, 3, u, span)
+    ends = np.array([u[0], u[-1]])
+    ends_span = find_span(U, 3, ends)
+    D = basis_function_derivatives(U, 3, ends, ends_span, 1)[:, 1, :]
+    cols = np.concatenate([span[:1, None], ends_span[:1, None], span[1:-1, None], ends_span[1:, None], span[-1:, None]]) - 3
+    cols = cols + np.arange(4)
+    vals = np.concatenate([N[:1], D[:1], N[1:-1], D[1:], N[-1:]])
+    rhs = np.concatenate([Q[:1], np.asarray(start_derivative)[None], Q[1:-1], np.asarray(end_derivative_)[None], Q[-1:]])
+    rows = np.broadcast_to(np.arange(n + 3)[:, None], cols.shape)
+    nz = vals != 0.0
+    offsets = (cols - rows)[nz]
+    upper, lower = max(int(offsets.max()), 0), max(int(-offsets.min()), 0)
+    ab = np.zeros((lower + upper + 1, n + 3))
+    ab[(upper + rows - cols)[nz], cols[nz]] = vals[nz]
+    try:
+        P = solve_banded((lower, upper), ab, rhs)
+    except np.linalg.LinAlgError as exc:
+        raise GeometryError(f"the interpolation at the knots is singular ({exc})") from None
+    return BSplineCurve(3, U, P)
+
+
+def spline_through(points: np.ndarray, end_derivative_order: int, params=None) -> tuple[BSplineCurve, np.ndarray]:
+    """Chord-length parameters (normalised to [0, 1]) and the cubic through the points with
+    knots at them and finite-difference end tangents (§3.2 step 1)."""
+    Q = np.asarray(points, dtype=np.float64)
+    if params is None:
+        chords = np.linalg.norm(np.diff(Q, axis=0), axis=1)
+        if np.any(chords <= 0.0):
+            k = int(np.flatnonzero(chords <= 0.0)[0]) + 1
+            raise GeometryError(f"point {k} repeats point {k - 1} ({Q[k].tolist()}); remove duplicates")
+        params = np.concatenate([[0.0], np.cumsum(chords)])
+        params /= params[-1]
+    d0 = end_derivative(params, Q, end_derivative_order)
+    dn = end_derivative(params, Q, end_derivative_order, at_end=True)
+    return interpolate_at_knots(Q, params, d0, dn), params
+
+
+@dataclass(frozen=True)
+class _KnotCurvature:
+    """C'(u_i) and C''(u_i) as fixed linear maps of the control points (knots never move):
+    four columns per knot, so κ_i of any control net costs two small gathers."""
+
+    cols: np.ndarray  # (N, 4)
+    d1: np.ndarray  # (N, 4)
+    d2: np.ndarray  # (N, 4)
+
+    @classmethod
+    def of(cls, curve: BSplineCurve, params: np.ndarray) -> "_KnotCurvature":
+        span = find_span(curve.knots, 3, params)
+        ders = basis_function_derivatives(curve.knots, 3, params, span, 2)
+        return cls(span[:, None] - 3 + np.arange(4), ders[:, 1, :], ders[:, 2, :])
+
+    def derivatives(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        G = P[self.cols]
+        return np.einsum("nk,nkd->nd", self.d1, G), np.einsum("nk,nkd->nd", self.d2, G)
+
+    def curvature(self, P: np.ndarray) -> np.ndarray:
+        """κ_i of Hvid (1993) Eq. 2.10 with numerator ẋÿ − ẏẍ."""
+        a, b = self.derivatives(P)
+        return (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / np.hypot(a[:, 0], a[:, 1]) ** 3
+
+    def normals(self, P: np.ndarray) -> np.ndarray:
+        a, _ = self.derivatives(P)
+        return np.stack([-a[:, 1], a[:, 0]], axis=1) / np.hypot(a[:, 0], a[:, 1])[:, None]
+
+
+# =======================================================================================
+# step 2: the smoothed curvature target
+# =======================================================================================
+def smooth_curvature(kappa, smoother: str = "ad_hoc", passes: int = 4, smoothing_type: int = 2, weight: float = 10.0) -> np.ndarray:
+    """Target curvature κ* from κ at the knots (Hvid 1993 §3.2 step 2).
+
+    ``"ad_hoc"``: ``passes`` passes of κ*_i = (κ_{i−1} + κ_i + κ_{i+1})/3; at the two ends
+    the missing neighbour is replaced by the end value itself, (2κ_0 + κ_1)/3.
+    ``"least_squares"``: the penalised least-squares cubic spline in the point index i,
+    minimising Σ w_i (κ_i − g(i))² + λ ∫ g''² di (scipy ``make_smoothing_spline``) with
+    λ = ``weight`` (0: generalised cross-validation). Unlike the 3-point mean it leaves
+    a smooth curvature (the leading-edge peak) nearly untouched while removing
+    point-to-point noise, so it moves the curve far less (issue 6 acceptance, NACA 0012).
+    smoothing_type 2 keeps κ at the point of largest |κ| (the airfoil's leading edge,
+    §3.4 "smttype"); type 1 smooths every point.
+    """
+    k = np.array(kappa, dtype=np.float64)
+    keep = int(np.argmax(np.abs(k)))
+    kept = k[keep]
+    if smoother == "ad_hoc":
+        for _ in range(int(passes)):
+            padded = np.concatenate([k[:1], k, k[-1:]])
+            k = (padded[:-2] + padded[1:-1] + padded[2:]) / 3.0
+            if smoothing_type == 2:
+                k[keep] = kept
+    elif smoother == "least_squares":
+        n = k.size
+        x = np.arange(n, dtype=np.float64)
+        w = np.ones(n)
+        if smoothing_type == 2:
+            w[keep] = KEEP_MAX_WEIGHT
+        k = make_smoothing_spline(x, k, w=w, lam=float(weight) if weight else None)(x)
+        if smoothing_type == 2:
+            k[keep] = kept
+    else:
+        raise DefinitionError(f"smoother must be one of {SMOOTHERS}, got {smoother!r}", field="smoother")
+    return k
+
+
+# =======================================================================================
+# steps 3-5: the Newton/secant iteration
+# =======================================================================================
+def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float) -> np.ndarray:
+    """Tridiagonal J_ij = ∂κ_i/∂(ε n_j), j ↔ control point P_{j+1} (Hvid's d_j), in
+    LAPACK band storage ab[1 + i − j, j]. Three perturbed evaluations: vertices j ≡ c
+    (mod 3) are moved together, since κ_i only sees d_{i−1}, d_i, d_{i+1}."""
+    N = kappa.size
+    ab = np.zeros((3, N))
+    j_all = np.arange(N)
+    i_all = np.arange(N)
+    for c in range(3):
+        moved = j_all % 3 == c
+        Q = P.copy()
+        Q[1:-1][moved] += step * normals[moved]
+        dk = (op.curvature(Q) - kappa) / step
+        offset = (c - i_all + 1) % 3 - 1  # j - i for the moved vertex each κ_i sees
+        j = i_all + offset
+        ok = (j >= 0) & (j < N)
+        ab[1 + i_all[ok] - j[ok], j[ok]] = dk[ok]
+    return ab
+
+
+def newton_curvature(
+    curve: BSplineCurve,
+    params: np.ndarray,
+    target: np.ndarray,
+    max_iterations: int,
+    tolx: float,
+    tolf: float,
+    progress: Progress | None = None,
+) -> tuple[BSplineCurve, list[tuple[float, float]], bool, str]:
+    """Steps 3–5 of Hvid (1993) §3.2 on a cubic with knots at ``params`` (reference length
+    1). Returns (curve, history of (Σ|κ−κ*|, Σ|δ|), converged, reason); the end control
+    points P_0 = r_0 and P_{n+2} = r_n never move."""
+    op = _KnotCurvature.of(curve, params)
+    P = np.array(curve.control_points)
+    history: list[tuple[float, float]] = []
+    first = None
+    for iteration in range(1, int(max_iterations) + 1):
+        kappa = op.curvature(P)
+        residual = kappa - target
+        errf = float(np.sum(np.abs(residual)))
+        if not np.isfinite(errf):
+            return curve.with_control_points(P), history, False, "the curvature became non-finite"
+        if errf <= tolf:
+            history.append((errf, 0.0))
+            return curve.with_control_points(P), history, True, "tolf"
+        first = errf if first is None else first
+        if errf > DIVERGENCE_FACTOR * first:
+            history.append((errf, float("nan")))
+            return curve.with_control_points(P), history, False, "the residual diverged"
+        normals = op.normals(P)
+        ab = _jacobian_bands(op, P, kappa, normals, JACOBIAN_STEP)
+        try:
+            delta = solve_banded((1, 1), ab, -residual)
+        except np.linalg.LinAlgError:
+            history.append((errf, float("nan")))
+            return curve.with_control_points(P), history, False, "the Jacobian is singular"
+        errx = float(np.sum(np.abs(delta)))
+        history.append((errf, errx))
+        if not np.all(np.isfinite(delta)) or np.max(np.abs(delta)) > MAX_STEP:
+            return curve.with_control_points(P), history, False, (
+                f"a step of {np.max(np.abs(delta)):.3g} exceeds {MAX_STEP} of the reference length (diverging)"
+            )
+        P[1:-1] += delta[:, None] * normals
+        if progress is not None:
+            progress(iteration, int(max_iterations))
+        if errx <= tolx:
+            kappa = op.curvature(P)
+            history.append((float(np.sum(np.abs(kappa - target))), 0.0))
+            return curve.with_control_points(P), history, True, "tolx"
+    return curve.with_control_points(P), history, False, f"ntrial = {max_iterations} iterations reached"
+
+
+# =======================================================================================
+# results
+# =======================================================================================
+@dataclass(frozen=True)
+class Deviation:
+    """Deviations between the smoothed curve and its references, in units of the reference
+    length (fractions of chord for airfoils).
+
+    same_parameter: Hvid's ds (§3.2.1), |S(u) − C(u)| at equal parameters, max.
+    true: Hausdorff distance between the curves (closest points both ways), sampled.
+    data: largest distance of the input data points from the smoothed curve.
+    profile: (normalised arc length, distance) of the smoothed curve's samples to the
+    unsmoothed one, for the plot of Hvid's Fig. 3.4.
+    """
+
+    same_parameter: float
+    true: float
+    data: float
+    profile: tuple[np.ndarray, np.ndarray] = field(repr=False, default=(np.empty(0), np.empty(0)))
+
+
+@dataclass(frozen=True)
+class SmoothingResult:
+    """What smooth2D / smoothfoil hand back, in the input's coordinates.
+
+    curve: the smoothed cubic B-spline. unsmoothed: the cubic through the redistributed
+    points before smoothing (Hvid's "original"). source: the cubic through the input data.
+    params: u_i of the knots. kappa_before / kappa_target / kappa_after: κ at the knots
+    (input units; airfoils: sign such that convex is positive). history: (Σ|κ−κ*|, Σ|δ|) per
+    iteration (reference length 1). reference_length: chord (airfoil) or bounding-box
+    diagonal (smooth2D). points: the np output points on the smoothed curve.
+    dense_before / dense_after: (min, max) κ over the whole curves (sampled between knots too).
+    """
+
+    curve: BSplineCurve
+    unsmoothed: BSplineCurve
+    source: BSplineCurve
+    params: np.ndarray
+    kappa_before: np.ndarray
+    kappa_target: np.ndarray
+    kappa_after: np.ndarray
+    history: tuple
+    converged: bool
+    reason: str
+    reference_length: float
+    deviation: Deviation
+    distribution: DistributionReport
+    points: np.ndarray
+    dense_before: tuple[float, float]
+    dense_after: tuple[float, float]
+    kind: str = "smooth2D"
+    curvature_sign: float = 1.0
+    chord_scale: float = 1.0
+
+    @property
+    def iterations(self) -> int:
+        return len([h for h in self.history if h[1] != 0.0 or not self.converged])
+
+    def lines(self) -> list[str]:
+        """A printout in the manner of Hvid's session (§3.4)."""
+        out = [f"{self.kind}: {len(self.params)} smoothing points, reference length {self.reference_length:.9g}"]
+        out += self.distribution.lines()
+        out.append(f"initial curvature: min {self.kappa_before.min():.6f}  max {self.kappa_before.max():.6f}")
+        for k, (f, x) in enumerate(self.history, 1):
+            out.append(f"iteration no. {k}: {f:.10f} {x:.10f}")
+        out.append(f"{self.reason} criteria" if self.converged else f"NOT CONVERGED: {self.reason}")
+        out.append(f"smoothed curvature: min {self.kappa_after.min():.6f}  max {self.kappa_after.max():.6f}")
+        out.append(
+            f"max deviation / reference length: true {self.deviation.true:.3e}, same parameter "
+            f"{self.deviation.same_parameter:.3e}, data points {self.deviation.data:.3e}"
+        )
+        return out
+
+
+def write_points(path, points) -> None:
+    """Write (x, y) rows at full float64 precision (repr, 17 significant digits), atomically
+    (temporary file in the same folder, then os.replace) — Hvid's output step (§3.3
+    "Output" warns that formatted writing destroys the smoothing)."""
+    path = pathlib.Path(path)
+    P = np.asarray(points, dtype=np.float64)
+    text = "".join(f"{x!r} {y!r}\n" for x, y in P[:, :2].tolist())
+    atomic_write(path, f"{P.shape[0]}\n{text}")
+
+
+# =======================================================================================
+# shared pipeline
+# =======================================================================================
+def _transform_curve(curve: BSplineCurve, scale: float, rotation: np.ndarray, origin: np.ndarray) -> BSplineCurve:
+    """x ↦ origin + scale · (R x): exact on the control points."""
+    return curve.with_control_points(origin + scale * (curve.control_points @ rotation.T))
+
+
+def _dense_extremes(curve: BSplineCurve, sign: float) -> tuple[float, float]:
+    k = sign * curvature_at(curve, span_samples(curve, DEVIATION_SAMPLES_PER_SPAN))
+    return float(k.min()), float(k.max())
+
+
+def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndarray, data: np.ndarray, measure: bool = True) -> Deviation:
+    same = float(np.max(np.linalg.norm(smoothed.evaluate(params) - unsmoothed.evaluate(params), axis=1)))
+    if not measure:
+        return Deviation(same, float("nan"), float("nan"))
+    us = span_samples(smoothed, DEVIATION_SAMPLES_PER_SPAN)
+    _, d1 = closest_point_curve(unsmoothed, smoothed.evaluate(us))
+    _, d2 = closest_point_curve(smoothed, unsmoothed.evaluate(span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)))
+    _, d3 = closest_point_curve(smoothed, data)
+    t, s = arclength_table(smoothed, DEVIATION_SAMPLES_PER_SPAN)
+    return Deviation(same, float(max(d1.max(), d2.max())), float(d3.max()), (s / s[-1], d1))
+
+
+def _run(
+    source: BSplineCurve,
+    fractions: np.ndarray,
+    output_fractions: np.ndarray,
+    settings: SmoothingSettings,
+    progress: Progress | None,
+    rescale_chord: Callable[[BSplineCurve, BSplineCurve], tuple[BSplineCurve, float]] | None = None,
+):
+    """Redistribute, interpolate, smooth the curvature, iterate (reference length 1)."""
+    table = arclength_table(source)
+    u_src = params_at_arclength(source, fractions, table)
+    r = derivatives(source, u_src, 0)[0]
+    report = distribution_report(derivatives(source, params_at_arclength(source, output_fractions, table), 0)[0])
+    unsmoothed, params = spline_through(r, settings.end_derivative_order)
+    op = _KnotCurvature.of(unsmoothed, params)
+    kappa0 = op.curvature(unsmoothed.control_points)
+    target = smooth_curvature(
+        kappa0, settings.smoother, settings.passes, settings.smoothing_type, settings.smoothing_weight
+    )
+    curve, history, converged, reason = newton_curvature(
+        unsmoothed, params, target, settings.max_iterations, settings.tolx, settings.tolf, progress
+    )
+    chord_scale = 1.0
+    if converged and rescale_chord is not None:
+        curve, chord_scale = rescale_chord(curve, unsmoothed)
+    kappa1 = op.curvature(curve.control_points)
+    return unsmoothed, params, curve, kappa0, target, kappa1, history, converged, reason, report, chord_scale
+
+
+def _fail(kind: str, history, reason: str):
+    raise SmoothingNotConverged(
+        f"{kind}: the smoothing did not converge (Hvid 1993 §3.2.2: smooth less, e.g. fewer passes, "
+        f"or use more iterations); the curve was not changed",
+        history,
+        reason,
+    )
+
+
+def _as_points(points, what: str) -> np.ndarray:
+    Q = np.array(points, dtype=np.float64)
+    if Q.ndim != 2 or Q.shape[1] != 2:
+        raise GeometryError(f"{what}: expected (count, 2) points, got shape {Q.shape}")
+    if Q.shape[0] < 5:
+        raise GeometryError(f"{what}: need at least 5 points, got {Q.shape[0]}")
+    if not np.all(np.isfinite(Q)):
+        k = int(np.argwhere(~np.isfinite(Q))[0, 0])
+        raise GeometryError(f"{what}[{k}] is not finite ({Q[k].tolist()})")
+    gaps = np.linalg.norm(np.diff(Q, axis=0), axis=1)
+    size = float(np.linalg.norm(np.ptp(Q, axis=0)))
+    if np.any(gaps <= 1e-12 * size):
+        k = int(np.flatnonzero(gaps <= 1e-12 * size)[0]) + 1
+        raise GeometryError(f"{what}[{k}] = {Q[k].tolist()} duplicates point {k - 1}")
+    return Q
+
+
+# =======================================================================================
+# smooth2D
+# =======================================================================================
+def smooth2d(
+    data,
+    alpha: float = 1.0,
+    settings: SmoothingSettings | None = None,
+    progress: Progress | None = None,
+    raise_on_failure: bool = True,
+    measure: bool = True,
+) -> SmoothingResult:
+    """Hvid's smooth2D (1993 §3.3): smooth any plane curve.
+
+    data: (m, 2) points (interpolated first, §3.2 step 1) or a 2-D BSplineCurve (used as it
+    is when its degree is at least 2; a polyline's vertices are interpolated). Closed curves
+    are smoothed as open ones whose two ends stay fixed.
+    alpha: damping α of the curvature-weighted distribution (:func:`curvature_fractions`).
+    Raises :class:`SmoothingNotConverged` (with the residual history) when the iteration
+    fails, unless ``raise_on_failure`` is False.
+    """
+    settings = settings or SmoothingSettings(smoothing_type=1)
+    if isinstance(data, BSplineCurve):
+        if data.dim != 2:
+            raise GeometryError(f"smooth2D needs a plane (2-D) curve, got dimension {data.dim}")
+        points = _as_points(data.control_points, "curve control points") if data.degree == 1 else None
+        raw = data if data.degree >= 2 else None
+    else:
+        points, raw = _as_points(data, "points"), None
+    sample = raw.evaluate(span_samples(raw, 4)) if raw is not None else points
+    lo = sample.min(axis=0)
+    ref = float(np.linalg.norm(sample.max(axis=0) - lo))
+    if ref <= 0:
+        raise GeometryError("smooth2D: the curve has zero extent")
+    eye = np.eye(2)
+    if raw is not None:
+        source = _transform_curve(raw, 1.0 / ref, eye, -lo / ref)
+        data_points = source.evaluate(span_samples(source, 1))
+    else:
+        data_points = (points - lo) / ref
+        source, _ = spline_through(data_points, settings.end_derivative_order)
+    fractions = curvature_fractions(source, settings.smoothing_points, alpha)
+    output_fractions = curvature_fractions(source, settings.output_points, alpha)
+    (unsmoothed, params, curve, k0, target, k1, history, converged, reason, report, _) = _run(
+        source, fractions, output_fractions, settings, progress
+    )
+    if not converged and raise_on_failure:
+        _fail("smooth2D", history, reason)
+    deviation = _deviation(curve, unsmoothed, params, data_points, measure)
+    out_fr = curvature_fractions(curve, settings.output_points, alpha)
+    out_points = curve.evaluate(params_at_arclength(curve, out_fr))
+    back = lambda c: _transform_curve(c, ref, eye, lo)  # noqa: E731
+    return SmoothingResult(
+        curve=back(curve),
+        unsmoothed=back(unsmoothed),
+        source=back(source),
+        params=params,
+        kappa_before=k0 / ref,
+        kappa_target=target / ref,
+        kappa_after=k1 / ref,
+        history=tuple(history),
+        converged=converged,
+        reason=reason,
+        reference_length=ref,
+        deviation=deviation,
+        distribution=DistributionReport(report.max_ratio, report.first_segment * ref, report.last_segment * ref, report.count),
+        points=lo + ref * out_points,
+        dense_before=tuple(v / ref for v in _dense_extremes(unsmoothed, 1.0)),
+        dense_after=tuple(v / ref for v in _dense_extremes(curve, 1.0)),
+        kind="smooth2D",
+    )
+
+
+# =======================================================================================
+# smoothfoil
+# =======================================================================================
+def _farthest_point(curve: BSplineCurve, origin: np.ndarray) -> float:
+    """Parameter of the point of ``curve`` farthest from ``origin`` (the leading edge seen
+    from the trailing edge): dense samples, then Newton on (C − T)·C' = 0."""
+    u = span_samples(curve, DEVIATION_SAMPLES_PER_SPAN)
+    k = int(np.argmax(np.linalg.norm(derivatives(curve, u, 0)[0] - origin, axis=1)))
+    t, lo, hi = u[k], u[max(k - 1, 0)], u[min(k + 1, u.size - 1)]
+    for _ in range(LEADING_EDGE_NEWTON_STEPS):
+        D = derivatives(curve, t, 2)
+        g = np.dot(D[0] - origin, D[1])
+        h = np.dot(D[1], D[1]) + np.dot(D[0] - origin, D[2])
+        if h >= 0:
+            break
+        t = float(np.clip(t - g / h, lo, hi))
+    return float(t)
+
+
+def _chord_frame(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
+    """(LE, TE midpoint, chord, rotation R with R (TE − LE)/chord = (1, 0))."""
+    te = 0.5 * (points[0] + points[-1])
+    i_le = int(np.argmax(np.linalg.norm(points - te, axis=1)))
+    if i_le < MIN_POINTS_PER_SIDE or i_le > points.shape[0] - 1 - MIN_POINTS_PER_SIDE:
+        raise GeometryError(
+            f"smoothfoil: the leading edge (point {i_le} of {points.shape[0]}, farthest from the trailing edge) "
+            f"must have at least {MIN_POINTS_PER_SIDE} points on each side; is the outline ordered TE -> LE -> TE?"
+        )
+    le = points[i_le]
+    chord = float(np.linalg.norm(te - le))
+    c, s = (te - le) / chord
+    return le, te, chord, np.array([[c, s], [-s, c]])
+
+
+def _extend_trailing_edge(points: np.ndarray, order: int) -> tuple[np.ndarray, int, int]:
+    """Hvid (1993) §3.3 "Airfoil preparation" step 1: extend both trailing-edge ends
+    along their end tangents to the point where the tangents meet. Returns the new outline
+    (apex first and last) and the number of points added at each end."""
+    spline, _ = spline_through(points, order)
+    t0 = -spline.derivatives(spline.domain[0], 1)[1]
+    t1 = spline.derivatives(spline.domain[1], 1)[1]
+    t0, t1 = t0 / np.linalg.norm(t0), t1 / np.linalg.norm(t1)
+    p0, p1 = points[0], points[-1]
+    A = np.stack([t0, -t1], axis=1)
+    det = np.linalg.det(A)
+    if abs(det) < 1e-12:
+        raise GeometryError("smoothfoil: the trailing-edge tangents are parallel; a blunt trailing edge cannot be extended")
+    a, b = np.linalg.solve(A, p1 - p0)
+    gap = float(np.linalg.norm(p1 - p0))
+    if a <= 0 or b <= 0 or max(a, b) > 1.0:
+        raise GeometryError(
+            f"smoothfoil: the trailing-edge tangents do not meet behind the trailing edge (extensions {a:.3g}, {b:.3g} "
+            f"chord for a gap of {gap:.3g}); cannot extend the blunt trailing edge (Hvid 1993 §3.3)"
+        )
+    apex = p0 + a * t0
+    h0 = float(np.linalg.norm(points[1] - points[0]))
+    h1 = float(np.linalg.norm(points[-1] - points[-2]))
+    k0 = max(2, int(np.ceil(a / h0)))
+    k1 = max(2, int(np.ceil(b / h1)))
+    head = apex + (p0 - apex) * (np.arange(k0) / k0)[:, None]
+    tail = p1 + (apex - p1) * (np.arange(1, k1 + 1) / k1)[:, None]
+    return np.concatenate([head, points, tail]), k0, k1
+
+
+def smoothfoil(
+    data,
+    distribution: PolynomialDistribution | None = None,
+    settings: SmoothingSettings | None = None,
+    progress: Progress | None = None,
+    raise_on_failure: bool = True,
+    measure: bool = True,
+    rescale: bool = True,
+    realign: bool = False,
+) -> SmoothingResult:
+    """Hvid's smoothfoil (1993 §3.2.1, §3.3, §3.4): smooth an airfoil outline.
+
+    data: an :class:`Airfoil` (taken lower side first, TE → lower → LE → upper → TE, the
+    order of the paper's fx66 file, so f(½) = 0.491 puts the leading edge at the middle
+    point), or (m, 2) outline points TE → LE → TE in either direction and at any chord,
+    position and angle (§3.3: smoothed at unit chord, mapped back).
+    distribution: the §3.3 polynomial (default: the paper's 0.5, 0.5, 0.491, 0.1).
+    Blunt trailing edges are extended, smoothed and cut back (§3.3 steps 1–4). The smoothed
+    airfoil is rescaled to its original chord (§3.2). Curvatures are reported at unit
+    chord with convex stretches positive; deviations as fractions of chord.
+    """
+    settings = settings or SmoothingSettings()
+    distribution = distribution or PolynomialDistribution(0.5, 0.5, 0.491, 0.1)
+    if isinstance(data, Airfoil):
+        points = np.concatenate([data.lower[::-1], data.upper[1:]])
+    else:
+        points = _as_points(data, "airfoil outline")
+    le, te, chord, R = _chord_frame(points)
+    unit = ((points - le) @ R.T) / chord  # LE at the origin, TE mid-point at (1, 0)
+    blunt = float(np.linalg.norm(unit[0] - unit[-1])) > SHARP_TE_TOL
+    work, k0, k1 = (_extend_trailing_edge(unit, settings.end_derivative_order) if blunt else (unit, 0, 0))
+    if blunt:
+        # §3.3 step 2: the extended airfoil at unit chord (apex at (1, 0))
+        le2, _, chord2, R2 = _chord_frame(work)
+        work = ((work - le2) @ R2.T) / chord2
+    else:
+        work = work.copy()
+        work[-1] = work[0]  # a sharp trailing edge: both ends exactly at the same point
+        le2, chord2, R2 = np.zeros(2), 1.0, np.eye(2)
+    # area sign: the outline runs clockwise (< 0) or anticlockwise; convex is positive
+    x, y = work[:, 0], work[:, 1]
+    sign = 1.0 if np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0 else -1.0
+    source, _ = spline_through(work, settings.end_derivative_order)
+    apex = work[0].copy()
+
+    def rescale_chord(curve: BSplineCurve, unsmoothed: BSplineCurve) -> tuple[BSplineCurve, float]:
+        # §3.2: the smoothed airfoil gets the chord of the original one (leading edge =
+        # farthest point from the trailing edge). With ``realign`` the similarity about the
+        # trailing edge also puts the leading edge back where it was, undoing the small
+        # rotation that a changed trailing-edge tangent gives the whole outline.
+        a = curve.evaluate(_farthest_point(curve, apex)) - apex
+        b = unsmoothed.evaluate(_farthest_point(unsmoothed, apex)) - apex
+        factor = float(np.linalg.norm(b) / np.linalg.norm(a))
+        rot = np.eye(2)
+        if realign:
+            c, s = (a[0] * b[0] + a[1] * b[1]), (a[0] * b[1] - a[1] * b[0])
+            rot = np.array([[c, -s], [s, c]]) / float(np.hypot(c, s))
+        return curve.with_control_points(apex + factor * ((curve.control_points - apex) @ rot.T)), factor
+
+    fractions = distribution.fractions(settings.smoothing_points)
+    output_fractions = distribution.fractions(settings.output_points)
+    (unsmoothed, params, curve, k0_, target, k1_, history, converged, reason, report, factor) = _run(
+        source, fractions, output_fractions, settings, progress, rescale_chord if rescale else None
+    )
+    if not converged and raise_on_failure:
+        _fail("smoothfoil", history, reason)
+    u_out = params_at_arclength(curve, output_fractions)
+    out_points = curve.evaluate(u_out)
+    cut = curve
+    if blunt:
+        # §3.3 step 4: cut back at the original trailing-edge ends
+        ends = np.stack([work[k0], work[-1 - k1]])
+        (ua, ub), _ = closest_point_curve(curve, ends)
+        cut = split(split(curve, float(ua))[1], float(ub))[0]
+        inside = (u_out > ua) & (u_out < ub)
+        out_points = np.concatenate([cut.evaluate(cut.domain[0])[None], out_points[inside], cut.evaluate(cut.domain[1])[None]])
+    deviation = _deviation(curve, unsmoothed, params, work, measure)
+    # back to the input frame: x ↦ le + chord · Rᵀ (le2 + chord2 R2ᵀ x)
+    Rt, R2t = R.T, R2.T
+
+    def back(c: BSplineCurve) -> BSplineCurve:
+        return _transform_curve(c, chord * chord2, Rt @ R2t, le + chord * (le2 @ R))
+
+    def back_points(p: np.ndarray) -> np.ndarray:
+        return le + chord * ((le2 + chord2 * (p @ R2)) @ R)
+
+    return SmoothingResult(
+        curve=back(cut),
+        unsmoothed=back(unsmoothed),
+        source=back(source),
+        params=params,
+        kappa_before=sign * k0_,
+        kappa_target=sign * target,
+        kappa_after=sign * k1_,
+        history=tuple(history),
+        converged=converged,
+        reason=reason,
+        reference_length=chord * chord2,
+        deviation=deviation,
+        distribution=report,
+        points=back_points(out_points),
+        dense_before=_dense_extremes(unsmoothed, sign),
+        dense_after=_dense_extremes(curve, sign),
+        kind="smoothfoil",
+        curvature_sign=sign,
+        chord_scale=factor,
+    )
+
+
+def smooth_airfoil_points(points, count: int | None = None, **options) -> np.ndarray:
+    """Optional pre-processing hook for section pipelines (propeller, wind blade): the
+    outline (m, 2) TE → LE → TE smoothed by :func:`smoothfoil` and resampled at ``count``
+    points (default m) in the input's frame and direction. ``options``: ``distribution``
+    and any :class:`SmoothingSettings` field. Raises :class:`SmoothingNotConverged`."""
+    P = _as_points(points, "airfoil outline")
+    distribution = options.pop("distribution", None)
+    settings = SmoothingSettings(**{"output_points": int(count or P.shape[0]), **options})
+    return smoothfoil(P, distribution, settings).points

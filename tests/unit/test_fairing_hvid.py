@@ -1,0 +1,242 @@
+"""smooth2D / smoothfoil (Hvid 1993 §3.2–3.4): invariants and the issue-6 acceptance cases
+that are not the paper's own figures (those are in tests/papers/test_hvid1993.py)."""
+
+import numpy as np
+import pytest
+
+from bladesmith.geometry.errors import BladesmithError, DefinitionError, GeometryError
+from bladesmith.geometry.fairing import (
+    PolynomialDistribution,
+    SmoothingNotConverged,
+    SmoothingSettings,
+    curve_sign_changes,
+    curve_total_variation,
+    smooth2d,
+    smooth_airfoil_points,
+    smooth_curvature,
+    smoothfoil,
+    write_points,
+)
+from bladesmith.geometry.fairing.hvid import _KnotCurvature, end_derivative, newton_curvature, spline_through
+from bladesmith.geometry.nurbs import closest_point_curve
+from bladesmith.geometry.sections.naca import naca4_thickness
+
+#: Noisy NACA 0012 case of the acceptance: noise amplitude and the deviation limit.
+NOISE = 1e-4
+DEVIATION_LIMIT = 2e-4
+
+
+def naca0012(count, closed=True):
+    """Outline TE → lower → LE → upper → TE with cosine spacing (count = 2k + 1 points)."""
+    beta = np.linspace(0.0, np.pi, count // 2 + 1)
+    x = 0.5 * (1.0 - np.cos(beta))
+    y = 0.06 * naca4_thickness(x, closed)
+    return np.concatenate([np.stack([x, -y], 1)[::-1], np.stack([x, y], 1)[1:]])
+
+
+@pytest.fixture(scope="module")
+def exact_naca():
+    return spline_through(naca0012(4001), 3)[0]
+
+
+# -- building blocks -------------------------------------------------------------------
+def test_end_derivative_exact_for_polynomials():
+    u = np.array([0.0, 0.1, 0.25, 0.5])
+    pts = np.stack([u, 3 * u**2 - u**3], axis=1)
+    assert np.allclose(end_derivative(u, pts, 3), [1.0, 0.0])
+    d = end_derivative(u, pts, 3, at_end=True)
+    assert np.allclose(d, [1.0, 6 * 0.5 - 3 * 0.25])
+
+
+def test_interpolation_at_knots_passes_through_points():
+    rng = np.random.default_rng(1)
+    pts = np.cumsum(rng.uniform(0.1, 1.0, size=(30, 2)), axis=0)
+    c, u = spline_through(pts, 2)
+    assert np.allclose(c.evaluate(u), pts, atol=1e-12)
+    assert c.n_control == len(pts) + 2
+    assert np.allclose(c.knots[3:-3], u)
+
+
+def test_knot_curvature_matches_evaluator():
+    t = np.linspace(0, 3, 40)
+    c, u = spline_through(np.stack([t, np.sin(t)], 1), 2)
+    op = _KnotCurvature.of(c, u)
+    assert np.allclose(op.curvature(c.control_points), c.curvature(u), rtol=1e-10)
+
+
+def test_ad_hoc_smoother_and_type2_keeps_maximum():
+    k = np.array([0.0, 1.0, 0.0, 9.0, 0.0, 1.0, 0.0])
+    one = smooth_curvature(k, "ad_hoc", 1, 1)
+    assert np.allclose(one[1:-1], (k[:-2] + k[1:-1] + k[2:])[: 5] / 3)
+    two = smooth_curvature(k, "ad_hoc", 4, 2)
+    assert two[3] == 9.0 and np.all(two[[0, 1, 2, 4, 5, 6]] < 9.0)
+    ls = smooth_curvature(k, "least_squares", 0, 2, 1.0)
+    assert ls[3] == 9.0
+
+
+def test_newton_reaches_its_own_curvature():
+    """A target equal to the current curvature is met at once; a small perturbation in a few steps."""
+    t = np.linspace(0, np.pi / 2, 60)
+    c, u = spline_through(np.stack([np.cos(t), np.sin(t)], 1), 2)
+    op = _KnotCurvature.of(c, u)
+    k = op.curvature(c.control_points)
+    out, hist, ok, reason = newton_curvature(c, u, k, 5, 1e-12, 1e-9)
+    assert ok and len(hist) == 1
+    target = k + 0.01 * np.sin(np.linspace(0, np.pi, k.size))
+    out, hist, ok, reason = newton_curvature(c, u, target, 10, 1e-12, 1e-9)
+    assert ok and len(hist) <= 6
+    assert np.allclose(_KnotCurvature.of(out, u).curvature(out.control_points), target, atol=1e-8)
+    assert np.allclose(out.control_points[[0, -1]], c.control_points[[0, -1]])  # ends stay
+
+
+def test_settings_refused_by_field():
+    with pytest.raises(DefinitionError, match="end_derivative_order"):
+        SmoothingSettings(end_derivative_order=4)
+    with pytest.raises(DefinitionError, match="smoother"):
+        SmoothingSettings(smoother="median")
+
+
+# -- acceptance: noisy NACA 0012 -------------------------------------------------------
+NACA_SETTINGS = SmoothingSettings(smoother="least_squares", smoothing_weight=10.0, smoothing_type=1)
+#: Wide trailing-edge spacing (f'(0) = f'(1) = 2): the curvature noise of a point is
+#: ~ noise / h², so coarse TE points keep it below the true TE curvature (~0.2).
+NACA_DISTRIBUTION = PolynomialDistribution(2.0, 2.0, 0.5, 0.1)
+SEEDS = range(1, 7)
+
+
+def _noisy_case(seed):
+    pts = naca0012(121)
+    rng = np.random.default_rng(seed)
+    noisy = pts.copy()
+    noisy[1:-1] += rng.uniform(-NOISE, NOISE, size=(len(pts) - 2, 2))
+    return noisy
+
+
+@pytest.fixture(scope="module")
+def noisy_results(exact_naca):
+    out = {}
+    for seed in SEEDS:
+        noisy = _noisy_case(seed)
+        r = smoothfoil(noisy, NACA_DISTRIBUTION, NACA_SETTINGS, measure=False)
+        _, d = closest_point_curve(exact_naca, r.curve.evaluate(np.linspace(*r.curve.domain, 1500)))
+        out[seed] = (spline_through(noisy, 2)[0], r, float(d.max()))
+    return out
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_noisy_naca0012_deviation(noisy_results, seed):
+    raw, r, deviation = noisy_results[seed]
+    assert r.converged and curve_sign_changes(raw) > 10
+    assert deviation < DEVIATION_LIMIT  # measured 0.97e-4 .. 1.47e-4
+
+
+def test_noisy_naca0012_sign_changes(exact_naca, noisy_results):
+    """Exact: 0 inflections; noisy: > 10. Smoothed: 0 for 5 of the 6 seeds; seed 1 keeps
+    one inflection in the last trailing-edge span (see the issue-6 report)."""
+    assert curve_sign_changes(exact_naca) == 0
+    changes = [curve_sign_changes(noisy_results[s][1].curve) for s in SEEDS]
+    assert max(changes) <= 1
+    assert changes.count(0) >= 5
+
+
+def test_exact_airfoil_barely_moves(exact_naca):
+    r = smoothfoil(naca0012(121), NACA_DISTRIBUTION, NACA_SETTINGS, measure=False)
+    _, d = closest_point_curve(exact_naca, r.curve.evaluate(np.linspace(*r.curve.domain, 1000)))
+    assert d.max() < DEVIATION_LIMIT  # the smoother alone moves the exact section ~1e-4
+
+
+def test_blunt_trailing_edge_is_cut_back():
+    pts = naca0012(121, closed=False)  # NACA 0012 open TE: 0.00252 c thick
+    r = smoothfoil(pts, NACA_DISTRIBUTION, NACA_SETTINGS)
+    a, b = r.curve.evaluate(np.array(r.curve.domain))
+    assert np.linalg.norm(a - pts[0]) < 2e-4 and np.linalg.norm(b - pts[-1]) < 2e-4
+    assert r.deviation.data < 2e-4
+    assert np.allclose(r.points[[0, -1]], [a, b])
+
+
+def test_smoothfoil_any_frame_and_chord():
+    """Scaled, rotated and shifted input: the same smoothing, mapped back."""
+    pts = naca0012(121)
+    ang = 0.7
+    R = np.array([[np.cos(ang), -np.sin(ang)], [np.sin(ang), np.cos(ang)]])
+    moved = 3.0 * pts @ R.T + [5.0, -2.0]
+    r0 = smoothfoil(pts, NACA_DISTRIBUTION, NACA_SETTINGS, measure=False)
+    r1 = smoothfoil(moved, NACA_DISTRIBUTION, NACA_SETTINGS, measure=False)
+    assert r1.reference_length == pytest.approx(3.0)
+    assert np.allclose(r1.points, 3.0 * r0.points @ R.T + [5.0, -2.0], atol=1e-9)
+    assert np.allclose(r1.kappa_after, r0.kappa_after, atol=1e-6)  # unit-chord curvature
+
+
+def test_hook_returns_points_in_input_frame():
+    pts = naca0012(121)
+    out = smooth_airfoil_points(2.0 * pts, count=99, distribution=NACA_DISTRIBUTION, smoother="least_squares")
+    assert out.shape == (99, 2)
+    assert np.allclose(out[[0, -1]], 2.0 * pts[[0, -1]], atol=1e-12)
+
+
+# -- acceptance: smooth2D on a noisy ellipse quadrant ----------------------------------
+def test_smooth2d_noisy_ellipse_quadrant():
+    th = np.linspace(0, np.pi / 2, 60)
+    exact_pts = np.stack([2 * np.cos(th), np.sin(th)], 1)
+    rng = np.random.default_rng(3)
+    noisy = exact_pts + rng.uniform(-5e-4, 5e-4, exact_pts.shape)
+    raw = spline_through(noisy, 2)[0]
+    r = smooth2d(noisy, 100.0, SmoothingSettings(smoothing_points=60, smoother="least_squares", smoothing_type=1))
+    ratio = curve_total_variation(raw) / curve_total_variation(r.curve)
+    assert ratio >= 5.0
+    tt = np.linspace(0, np.pi / 2, 2000)
+    exact = spline_through(np.stack([2 * np.cos(tt), np.sin(tt)], 1), 3)[0]
+    _, d = closest_point_curve(exact, r.curve.evaluate(np.linspace(*r.curve.domain, 2000)))
+    assert d.max() < 1e-3  # measured 7.9e-4 (noise ±5e-4)
+    assert curve_sign_changes(r.curve) == 0
+
+
+def test_smooth2d_closed_curve():
+    th = np.linspace(0, 2 * np.pi, 81)
+    rng = np.random.default_rng(4)
+    pts = np.stack([np.cos(th), 0.6 * np.sin(th)], 1)
+    pts[1:-1] += rng.uniform(-3e-4, 3e-4, (79, 2))
+    raw = spline_through(pts, 2)[0]
+    r = smooth2d(pts, 100.0, SmoothingSettings(smoothing_points=100, smoother="least_squares", smoothing_type=1))
+    assert np.allclose(r.curve.evaluate(np.array(r.curve.domain)), pts[[0, -1]])  # stays closed
+    # smoothed as an open curve with a fixed seam: measured 3.7x (not 5x; see the report)
+    assert curve_total_variation(raw) / curve_total_variation(r.curve) >= 3.0
+
+
+# -- acceptance: non-convergence --------------------------------------------------------
+def face_profile():
+    x = np.linspace(0, 1, 80)
+    return np.stack([x + 0.03 * np.sin(9 * np.pi * x), 0.15 * np.sin(5 * np.pi * x) + 0.04 * np.sin(17 * np.pi * x)], 1)
+
+
+def test_non_convergence_reports_history():
+    with pytest.raises(SmoothingNotConverged) as info:
+        smooth2d(face_profile(), 1.0, SmoothingSettings(smoothing_points=120, passes=20, smoothing_type=1))
+    exc = info.value
+    assert isinstance(exc, BladesmithError) and exc.history
+    assert "residual" in str(exc) and "did not converge" in str(exc)
+    r = smooth2d(face_profile(), 1.0, SmoothingSettings(smoothing_points=120, passes=20, smoothing_type=1), raise_on_failure=False)
+    assert not r.converged
+
+
+def test_ntrial_exhausted_is_not_converged():
+    pts = naca0012(121)
+    with pytest.raises(SmoothingNotConverged, match="ntrial"):
+        smoothfoil(pts, NACA_DISTRIBUTION, SmoothingSettings(max_iterations=1))
+
+
+# -- output -----------------------------------------------------------------------------
+def test_write_points_full_precision(tmp_path):
+    pts = np.array([[0.1, 1 / 3], [np.pi, -np.e]])
+    path = tmp_path / "smooth.dat"
+    write_points(path, pts)
+    lines = path.read_text().splitlines()
+    assert lines[0] == "2"
+    assert np.array_equal(np.array([[float(v) for v in ln.split()] for ln in lines[1:]]), pts)
+
+
+def test_bad_outline_refused():
+    with pytest.raises(GeometryError, match="duplicates"):
+        smoothfoil(np.array([[1, 0], [0.5, -0.05], [0.5, -0.05], [0, 0], [0.5, 0.05], [1, 0]], float))
+    with pytest.raises(GeometryError, match="not finite"):
+        smoothfoil(np.array([[1, 0], [0.5, np.nan], [0, 0], [0.3, 0.05], [0.5, 0.05], [1, 0]], float))
