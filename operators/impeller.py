@@ -19,7 +19,7 @@ from bpy.props import BoolProperty, EnumProperty, StringProperty
 from ..geometry.compressor import ImpellerDefinition, blade_net, distribution, dumps_toml
 from ..geometry.compressor.export import impeller_surfaces
 from ..geometry.errors import BladesmithError, DefinitionError
-from .nurbs_objects import surface_to_object
+from .nurbs_objects import PROPERTY_KEY, surface_to_object, write_surface
 
 PRESET_DIR = pathlib.Path(__file__).resolve().parent.parent / "data" / "impellers"
 ROOT_KEY = "bladesmith_impeller_root"
@@ -56,20 +56,62 @@ def net_to_mesh(net: np.ndarray, name: str, collection):
     return obj
 
 
+def _remove(obj) -> None:
+    data = obj.data
+    bpy.data.objects.remove(obj)
+    if data is not None and data.users == 0:
+        (bpy.data.curves if isinstance(data, bpy.types.Curve) else bpy.data.meshes).remove(data)
+
+
+def _child(root, name: str, data, collection):
+    obj = bpy.data.objects.new(f"{root.name} {name}", data)
+    collection.objects.link(obj)
+    obj[PART_KEY] = name
+    obj.parent = root
+    return obj
+
+
 def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_net: bool) -> None:
-    """Build the model and (re)create the root's children; raises BladesmithError."""
+    """Build the model and make the root's children show it; raises BladesmithError.
+
+    The channel walls and the first blade (and splitter) are written in place into the
+    existing objects (:func:`write_surface` reuses their curve data); blades 2..Z are
+    linked copies of the first, rotated about the axis, so a panel edit rewrites one
+    blade, not Z. Children no longer needed are removed."""
     model = definition.build()
-    surfaces = impeller_surfaces(model, None if full_wheel else 1, include_camber=True)
-    for child in list(root.children):
-        data = child.data
-        bpy.data.objects.remove(child)
-        if data is not None and data.users == 0:
-            (bpy.data.curves if isinstance(data, bpy.types.Curve) else bpy.data.meshes).remove(data)
+    reference = impeller_surfaces(model, 1, include_camber=True)
+    existing = {child.get(PART_KEY): child for child in root.children}
     collection = root.users_collection[0]
-    for name, surface in surfaces:
-        obj = surface_to_object(surface, f"{root.name} {name}", collection, SURFACE_RESOLUTION)
-        obj[PART_KEY] = name
-        obj.parent = root
+    wanted = {}
+    for name, surface in reference:
+        obj = existing.get(name)
+        if obj is None or obj.type != "SURFACE":
+            obj = surface_to_object(surface, f"{root.name} {name}", collection, SURFACE_RESOLUTION)
+            obj[PART_KEY] = name
+            obj.parent = root
+        else:
+            write_surface(obj, surface, SURFACE_RESOLUTION)
+        wanted[name] = obj
+    count = model.count if full_wheel else 1
+    for k in range(1, count):
+        for name, _ in reference:
+            words = name.split(" ", 2)
+            if len(words) != 3 or words[0] not in ("blade", "splitter") or words[1] != "1" or words[2] == "B":
+                continue
+            label, _, part = words
+            source = wanted[name]
+            copy_name = f"{label} {k + 1} {part}"
+            obj = existing.get(copy_name)
+            if obj is None or obj.type != "SURFACE":
+                obj = _child(root, copy_name, source.data, collection)
+            elif obj.data is not source.data:
+                obj.data = source.data
+            obj.rotation_euler = (0.0, 0.0, float(model.blade_angle(k)))
+            obj[PROPERTY_KEY] = source[PROPERTY_KEY].to_dict()
+            wanted[copy_name] = obj
+    for name, obj in existing.items():
+        if name not in wanted:
+            _remove(obj)
     if show_net:
         net = blade_net(model.blade.camber, distribution(41, 1.5, 1.5), distribution(11))
         obj = net_to_mesh(net, f"{root.name} net B", collection)
