@@ -284,7 +284,10 @@ class BLADESMITH_OT_smooth_curve(bpy.types.Operator):
                 data = curve.control_points if curve.degree == 1 else curve.evaluate(span_samples(curve, AIRFOIL_SAMPLES_PER_SPAN))
             return smoothfoil(data, distribution, settings, progress), origin, axes
         curve, origin, axes = read_planar_curve(obj)
-        return smooth2d(curve, self.alpha, settings, progress), origin, axes
+        # a cyclic Blender spline is a closed curve (smoothed periodically, no fixed seam);
+        # otherwise smooth2d detects coinciding ends itself
+        cyclic = bool(obj.data.splines) and bool(obj.data.splines[0].use_cyclic_u)
+        return smooth2d(curve, self.alpha, settings, progress, closed=True if cyclic else None), origin, axes
 
 
 _classes = (BLADESMITH_OT_smooth_curve,)

@@ -18,10 +18,18 @@ curve (§3.2 "Conditioning the algorithm", distributions of §3.3):
    differences. Moving d_j changes κ only at u_{j−1}, u_j, u_{j+1} (§2, local control), so
    J is tridiagonal; the three diagonals come from three perturbed evaluations (every
    third vertex moved at once).
-4. Solve J δ = κ* − κ with ``scipy.linalg.solve_banded``.
+4. Solve J δ = κ* − κ with ``scipy.linalg.solve_banded`` (cyclic on closed curves).
 5. d_j ← d_j + δ_j n_j; repeat 3–5 (a secant method, §3.2) until Σ|κ − κ*| <= tolf or
    Σ|δ| <= tolx (the jobcard's "tolf"/"tolx"; iteration printout of §3.4), at most
    ``max_iterations`` ("ntrial") times.
+
+Closed curves (smooth2D) are smoothed as periodic ones, with no seam: the cubic through
+the N redistributed points is periodic (knots wrap around by the period, the last three
+of N + 3 control points repeat the first three, :func:`periodic_spline_through`), the
+curvature smoother wraps around, every control point moves and the Jacobian is cyclic
+tridiagonal (Sherman–Morrison on ``solve_banded``, :func:`solve_cyclic_tridiagonal`).
+Because nothing is pinned, κ* is shifted to keep ∮κ ds (:func:`_keep_turning`) and the
+result is moved back by the best rigid motion (:func:`_rigid_align`).
 
 smoothfoil (§3.3 "Airfoil preparation", §3.2.1) works at unit chord with a sharp trailing
 edge: blunt trailing edges are extended along the end tangents to a point, scaled to unit
@@ -63,6 +71,10 @@ JACOBIAN_STEP = 1e-7
 MAX_STEP = 0.05
 DIVERGENCE_FACTOR = 1e3
 
+#: smooth2D treats a curve as closed when its two ends are this close (relative to the
+#: bounding-box diagonal): float32 coordinates (Blender) round at ~6e-8.
+CLOSED_TOL = 1e-6
+
 #: Trailing-edge gap (fraction of chord) below which an airfoil counts as sharp.
 SHARP_TE_TOL = 1e-9
 
@@ -76,6 +88,25 @@ DEVIATION_SAMPLES_PER_SPAN = 6
 #: Weight of the kept maximum in the least-squares smoother of smoothing type 2 (relative
 #: to 1 for every other point): large enough to pin the fit to the value.
 KEEP_MAX_WEIGHT = 1e6
+
+#: Points over which the least-squares curvature smoother's weights taper at each end of
+#: an open curve (w_i = ((i + 1)/LS_END_TAPER)², i counted from the nearer end). κ at
+#: the first knots of a clamped spline is set by the finite-difference end tangent
+#: (iorder) as much as by the points, and its noise does not cancel the way the
+#: interior's does: κ_i is a second difference of the position noise, whose sum over a
+#: window telescopes to two tangent errors, but at an end one of them is the end-tangent
+#: error. A natural smoothing spline then extrapolates the end values linearly: on the
+#: noisy NACA 0012 (±1e-4 c, 180 points) its trailing-edge κ* scatters by 0.14 about the
+#: true 0.18 (a spurious inflection in 3 of 20 sections). Tapered over 6 points the
+#: scatter is 0.03 and the interior is unchanged (60 seeds); with the first-moment
+#: correction of :func:`_end_moment_correction` no section of 20 keeps an inflection and
+#: the deviation does not grow (max 1.5e-4 c against 1.9e-4 c untapered).
+LS_END_TAPER = 6
+
+#: Values wrapped around beyond each end of a closed curve before the least-squares
+#: curvature fit: the fit's influence decays over ~λ^(1/4) indices, so 24 values leave
+#: the result periodic to round-off for λ up to ~10^4.
+LS_END_PAD = 24
 
 #: Newton steps used to locate the leading edge (farthest point from the trailing edge).
 LEADING_EDGE_NEWTON_STEPS = 8
@@ -214,6 +245,71 @@ def spline_through(points: np.ndarray, end_derivative_order: int, params=None) -
     return interpolate_at_knots(Q, params, d0, dn), params
 
 
+def solve_cyclic_tridiagonal(lower: np.ndarray, diag: np.ndarray, upper: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """x with A x = rhs for the cyclic tridiagonal A: A[i, i−1] = lower[i], A[i, i] = diag[i],
+    A[i, i+1] = upper[i], indices mod N (so lower[0] = A[0, N−1] and upper[N−1] = A[N−1, 0]
+    are the corners). Sherman–Morrison on top of ``solve_banded``: A = B + u vᵀ with B
+    tridiagonal, u = (γ, 0, …, 0, A[N−1, 0]), v = (1, 0, …, 0, A[0, N−1]/γ), γ = −diag[0]
+    (Press et al., Numerical Recipes §2.7). ``rhs``: (N,) or (N, m)."""
+    lower, diag, upper = (np.asarray(a, dtype=np.float64) for a in (lower, diag, upper))
+    N = diag.size
+    b = np.asarray(rhs, dtype=np.float64)
+    B = b.reshape(N, -1)
+    top_right, bottom_left = lower[0], upper[-1]
+    gamma = -diag[0] if diag[0] != 0.0 else -1.0
+    ab = np.zeros((3, N))
+    ab[0, 1:] = upper[:-1]
+    ab[1] = diag
+    ab[2, :-1] = lower[1:]
+    ab[1, 0] -= gamma
+    ab[1, -1] -= bottom_left * top_right / gamma
+    u = np.zeros(N)
+    u[0], u[-1] = gamma, bottom_left
+    Y = solve_banded((1, 1), ab, np.column_stack([B, u]))
+    y, z = Y[:, :-1], Y[:, -1]
+    vz = z[0] + top_right / gamma * z[-1]
+    vy = y[0] + top_right / gamma * y[-1]
+    x = y - np.outer(z, vy / (1.0 + vz))
+    return x.reshape(b.shape)
+
+
+def periodic_knots(params: np.ndarray) -> np.ndarray:
+    """Knot vector of the closed cubic with breakpoints u_0..u_N (u_N closes the loop):
+    the three knots beyond each end are those of the other end shifted by the period, so
+    the N + 3 control points P_k = P_{k mod N} make the curve C² everywhere, seam included."""
+    u = np.asarray(params, dtype=np.float64)
+    T = u[-1] - u[0]
+    return np.concatenate([u[-4:-1] - T, u, u[1:4] + T])
+
+
+def periodic_spline_through(points: np.ndarray, params=None) -> tuple[BSplineCurve, np.ndarray]:
+    """Closed counterpart of :func:`spline_through` (§3.2 step 1 without end conditions):
+    the periodic cubic through N distinct points (the loop closes back to the first; do
+    not repeat it) with knots at their chord-length parameters u_0..u_{N−1} (u_N = 1 closes
+    the loop). At a knot only three basis functions are non-zero, so the system is cyclic
+    tridiagonal (:func:`solve_cyclic_tridiagonal`). Returns the curve (N + 3 control points,
+    the last three repeating the first three) and u_0..u_{N−1}."""
+    Q = np.asarray(points, dtype=np.float64)
+    N = Q.shape[0]
+    if N < 4:
+        raise GeometryError(f"a closed curve needs at least 4 distinct points, got {N}")
+    if params is None:
+        chords = np.linalg.norm(np.diff(np.concatenate([Q, Q[:1]]), axis=0), axis=1)
+        if np.any(chords <= 0.0):
+            k = int(np.flatnonzero(chords <= 0.0)[0])
+            raise GeometryError(f"point {(k + 1) % N} repeats point {k} ({Q[k].tolist()}); remove duplicates")
+        params = np.concatenate([[0.0], np.cumsum(chords)])
+        params /= params[-1]
+    u = np.asarray(params, dtype=np.float64)
+    U = periodic_knots(u)
+    span = np.arange(N) + 3  # U[i + 3] = u_i
+    Nb = basis_functions(U, 3, u[:-1], span)  # P_i, P_{i+1}, P_{i+2} (the fourth is 0 at the knot)
+    # unknown j is P_{(j+1) mod N}: row i sees unknowns i−1, i, i+1 (cyclic tridiagonal)
+    X = solve_cyclic_tridiagonal(Nb[:, 0], Nb[:, 1], Nb[:, 2], Q)
+    F = np.roll(X, 1, axis=0)
+    return BSplineCurve(3, U, F[np.arange(N + 3) % N]), u[:-1]
+
+
 @dataclass(frozen=True)
 class _KnotCurvature:
     """C'(u_i) and C''(u_i) as fixed linear maps of the control points (knots never move):
@@ -222,16 +318,25 @@ class _KnotCurvature:
     cols: np.ndarray  # (N, 4)
     d1: np.ndarray  # (N, 4)
     d2: np.ndarray  # (N, 4)
+    d0: np.ndarray  # (N, 4)
 
     @classmethod
-    def of(cls, curve: BSplineCurve, params: np.ndarray) -> "_KnotCurvature":
+    def of(cls, curve: BSplineCurve, params: np.ndarray, closed: bool = False) -> "_KnotCurvature":
+        """closed: ``curve`` is periodic (:func:`periodic_spline_through`); the columns then
+        index its N distinct control points (P_k = P_{k mod N})."""
         span = find_span(curve.knots, 3, params)
         ders = basis_function_derivatives(curve.knots, 3, params, span, 2)
-        return cls(span[:, None] - 3 + np.arange(4), ders[:, 1, :], ders[:, 2, :])
+        cols = span[:, None] - 3 + np.arange(4)
+        if closed:
+            cols = cols % (curve.n_control - 3)
+        return cls(cols, ders[:, 1, :], ders[:, 2, :], ders[:, 0, :])
 
     def derivatives(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         G = P[self.cols]
         return np.einsum("nk,nkd->nd", self.d1, G), np.einsum("nk,nkd->nd", self.d2, G)
+
+    def points(self, P: np.ndarray) -> np.ndarray:
+        return np.einsum("nk,nkd->nd", self.d0, P[self.cols])
 
     def curvature(self, P: np.ndarray) -> np.ndarray:
         """κ_i of Hvid (1993) Eq. 2.10 with numerator ẋÿ − ẏẍ."""
@@ -246,35 +351,102 @@ class _KnotCurvature:
 # =======================================================================================
 # step 2: the smoothed curvature target
 # =======================================================================================
-def smooth_curvature(kappa, smoother: str = "ad_hoc", passes: int = 4, smoothing_type: int = 2, weight: float = 10.0) -> np.ndarray:
+def _extend(k: np.ndarray, pad: int, closed: bool) -> np.ndarray:
+    """``k`` with ``pad`` values added at each end: wrapped around for a closed curve,
+    mirrored about the half-index beyond each end (…, κ_1, κ_0 | κ_0, κ_1, …) for an open one."""
+    if pad == 0:
+        return k
+    if closed:
+        reps = -(-pad // k.size)
+        ring = np.tile(k, 2 * reps + 1)
+        mid = reps * k.size
+        return ring[mid - pad : mid + k.size + pad]
+    pad = min(pad, k.size)
+    return np.concatenate([k[pad - 1 :: -1], k, k[: -pad - 1 : -1]])
+
+
+def _end_moment_correction(change: np.ndarray) -> np.ndarray:
+    """Correction c to a change Δκ* near the ends of an open curve such that, for each end,
+    Σ s_i (Δκ*_i + c_i) = 0 over that end's half, s_i = index distance from the end.
+
+    Why: the Newton step turns κ* − κ into a normal displacement d with d'' ≈ δκ, the end
+    point fixed and the end tangent free. A change of κ* near an end with a non-zero
+    first moment about that end bends the whole rest of the curve (far from the end,
+    d = −∫ s δκ ds); with zero first moment the displacement stays local. The correction
+    is c = a ψ with ψ = (s/S)(1 − s/S) on s < S = 2 :data:`LS_END_TAPER` (zero at the end
+    point itself, so the end values that the taper fixed are left alone)."""
+    n = change.size
+    x = np.arange(n, dtype=np.float64)
+    end = np.minimum(x, x[::-1])
+    span = 2.0 * LS_END_TAPER
+    psi = np.where(end < span, (end / span) * (1.0 - end / span), 0.0)
+    out = np.zeros(n)
+    for side in (x < 0.5 * (n - 1), x >= 0.5 * (n - 1)):
+        s = end[side]
+        out[side] = -np.sum(s * change[side]) / np.sum(s * psi[side]) * psi[side]
+    return out
+
+
+def smooth_curvature(
+    kappa,
+    smoother: str = "ad_hoc",
+    passes: int = 4,
+    smoothing_type: int = 2,
+    weight: float = 10.0,
+    closed: bool = False,
+) -> np.ndarray:
     """Target curvature κ* from κ at the knots (Hvid 1993 §3.2 step 2).
 
     ``"ad_hoc"``: ``passes`` passes of κ*_i = (κ_{i−1} + κ_i + κ_{i+1})/3; at the two ends
-    the missing neighbour is replaced by the end value itself, (2κ_0 + κ_1)/3.
+    of an open curve the missing neighbour is replaced by the end value itself,
+    (2κ_0 + κ_1)/3; on a closed curve the mean wraps around (κ_{−1} = κ_{N−1}).
     ``"least_squares"``: the penalised least-squares cubic spline in the point index i,
     minimising Σ w_i (κ_i − g(i))² + λ ∫ g''² di (scipy ``make_smoothing_spline``) with
     λ = ``weight`` (0: generalised cross-validation). Unlike the 3-point mean it leaves
     a smooth curvature (the leading-edge peak) nearly untouched while removing
     point-to-point noise, so it moves the curve far less (issue 6 acceptance, NACA 0012).
+    Open curves: natural spline ends (g'' = 0), with the weights w_i tapered to
+    ((i + 1)/:data:`LS_END_TAPER`)² over the last :data:`LS_END_TAPER` points at each end,
+    so the end values follow the interior trend instead of the end points' own κ (see
+    :data:`LS_END_TAPER` for why those are the least trustworthy); the change this makes
+    near each end is then corrected to zero first moment about that end
+    (:func:`_end_moment_correction`), so it does not bend the rest of the curve. Closed
+    curves: the sequence is fitted with
+    :data:`LS_END_PAD` values wrapped around beyond each end, so the fit is periodic to
+    round-off and the seam leaves no trace.
     smoothing_type 2 keeps κ at the point of largest |κ| (the airfoil's leading edge,
     §3.4 "smttype"); type 1 smooths every point.
     """
     k = np.array(kappa, dtype=np.float64)
+    n = k.size
     keep = int(np.argmax(np.abs(k)))
     kept = k[keep]
     if smoother == "ad_hoc":
         for _ in range(int(passes)):
-            padded = np.concatenate([k[:1], k, k[-1:]])
+            padded = _extend(k, 1, closed)
             k = (padded[:-2] + padded[1:-1] + padded[2:]) / 3.0
             if smoothing_type == 2:
                 k[keep] = kept
     elif smoother == "least_squares":
-        n = k.size
-        x = np.arange(n, dtype=np.float64)
         w = np.ones(n)
         if smoothing_type == 2:
             w[keep] = KEEP_MAX_WEIGHT
-        k = make_smoothing_spline(x, k, w=w, lam=float(weight) if weight else None)(x)
+        lam = float(weight) if weight else None
+        if closed:
+            pad = LS_END_PAD
+            kk, ww = _extend(k, pad, True), _extend(w, pad, True)
+            x = np.arange(kk.size, dtype=np.float64)
+            k = make_smoothing_spline(x, kk, w=ww, lam=lam)(x)[pad : pad + n]
+        else:
+            x = np.arange(n, dtype=np.float64)
+            natural = make_smoothing_spline(x, k, w=w, lam=lam)(x)
+            if LS_END_TAPER > 0 and n >= 4 * LS_END_TAPER:
+                end = np.minimum(x, x[::-1])
+                taper = np.minimum(1.0, (end + 1.0) / LS_END_TAPER) ** 2
+                tapered = make_smoothing_spline(x, k, w=w * taper, lam=lam)(x)
+                k = tapered + _end_moment_correction(tapered - natural)
+            else:
+                k = natural
         if smoothing_type == 2:
             k[keep] = kept
     else:
@@ -285,24 +457,42 @@ def smooth_curvature(kappa, smoother: str = "ad_hoc", passes: int = 4, smoothing
 # =======================================================================================
 # steps 3-5: the Newton/secant iteration
 # =======================================================================================
-def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float) -> np.ndarray:
-    """Tridiagonal J_ij = ∂κ_i/∂(ε n_j), j ↔ control point P_{j+1} (Hvid's d_j), in
-    LAPACK band storage ab[1 + i − j, j]. Three perturbed evaluations: vertices j ≡ c
-    (mod 3) are moved together, since κ_i only sees d_{i−1}, d_i, d_{i+1}."""
+def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float, rows: np.ndarray, closed: bool = False) -> np.ndarray:
+    """Tridiagonal J_ij = ∂κ_i/∂(ε n_j), vertex j ↔ control point ``P[rows[j]]`` (Hvid's
+    d_j), as bands[1 + j − i, i] (row i: ∂κ_i/∂d_{i−1}, ∂κ_i/∂d_i, ∂κ_i/∂d_{i+1}; on a
+    closed curve the indices wrap, so the corners are bands[0, 0] and bands[2, N−1]).
+    Vertices of one colour are moved together, since κ_i only sees d_{i−1}, d_i, d_{i+1}:
+    colour j mod 3, and on a closed curve with N not a multiple of 3 the last N mod 3
+    vertices get colours of their own so that no two moved vertices are within two of
+    each other across the seam."""
     N = kappa.size
-    ab = np.zeros((3, N))
-    j_all = np.arange(N)
-    i_all = np.arange(N)
-    for c in range(3):
-        moved = j_all % 3 == c
+    colour = np.arange(N) % 3
+    if closed and N % 3:
+        colour[N - N % 3 :] = 3 + np.arange(N % 3)
+    bands = np.zeros((3, N))
+    i = np.arange(N)
+    for c in range(int(colour.max()) + 1):
+        moved = colour == c
         Q = P.copy()
-        Q[1:-1][moved] += step * normals[moved]
+        Q[rows[moved]] += step * normals[moved]
         dk = (op.curvature(Q) - kappa) / step
-        offset = (c - i_all + 1) % 3 - 1  # j - i for the moved vertex each κ_i sees
-        j = i_all + offset
-        ok = (j >= 0) & (j < N)
-        ab[1 + i_all[ok] - j[ok], j[ok]] = dk[ok]
-    return ab
+        for o in (-1, 0, 1):
+            j = i + o
+            ok = np.ones(N, dtype=bool) if closed else (j >= 0) & (j < N)
+            j = j % N
+            ok &= moved[j]
+            bands[1 + o, i[ok]] = dk[ok]
+    return bands
+
+
+def _solve_jacobian(bands: np.ndarray, rhs: np.ndarray, closed: bool) -> np.ndarray:
+    if closed:
+        return solve_cyclic_tridiagonal(bands[0], bands[1], bands[2], rhs)
+    ab = np.zeros_like(bands)
+    ab[0, 1:] = bands[2, :-1]  # A[i, i+1] at ab[0, i+1]
+    ab[1] = bands[1]
+    ab[2, :-1] = bands[0, 1:]  # A[i, i−1] at ab[2, i−1]
+    return solve_banded((1, 1), ab, rhs)
 
 
 def newton_curvature(
@@ -313,12 +503,29 @@ def newton_curvature(
     tolx: float,
     tolf: float,
     progress: Progress | None = None,
+    closed: bool = False,
 ) -> tuple[BSplineCurve, list[tuple[float, float]], bool, str]:
     """Steps 3–5 of Hvid (1993) §3.2 on a cubic with knots at ``params`` (reference length
-    1). Returns (curve, history of (Σ|κ−κ*|, Σ|δ|), converged, reason); the end control
-    points P_0 = r_0 and P_{n+2} = r_n never move."""
-    op = _KnotCurvature.of(curve, params)
-    P = np.array(curve.control_points)
+    1). Returns (curve, history of (Σ|κ−κ*|, Σ|δ|), converged, reason). Open curves: the
+    end control points P_0 = r_0 and P_{n+2} = r_n never move. Closed (periodic, from
+    :func:`periodic_spline_through`): every control point moves, the Jacobian is cyclic
+    tridiagonal, and there is no seam."""
+    op = _KnotCurvature.of(curve, params, closed)
+    N = target.size
+    if closed:
+        P = np.array(curve.control_points[:N])
+        rows = (np.arange(N) + 1) % N
+        wrap = np.arange(N + 3) % N
+
+        def build(P):
+            return curve.with_control_points(P[wrap])
+    else:
+        P = np.array(curve.control_points)
+        rows = np.arange(N) + 1
+
+        def build(P):
+            return curve.with_control_points(P)
+
     history: list[tuple[float, float]] = []
     first = None
     for iteration in range(1, int(max_iterations) + 1):
@@ -326,35 +533,35 @@ def newton_curvature(
         residual = kappa - target
         errf = float(np.sum(np.abs(residual)))
         if not np.isfinite(errf):
-            return curve.with_control_points(P), history, False, "the curvature became non-finite"
+            return build(P), history, False, "the curvature became non-finite"
         if errf <= tolf:
             history.append((errf, 0.0))
-            return curve.with_control_points(P), history, True, "tolf"
+            return build(P), history, True, "tolf"
         first = errf if first is None else first
         if errf > DIVERGENCE_FACTOR * first:
             history.append((errf, float("nan")))
-            return curve.with_control_points(P), history, False, "the residual diverged"
+            return build(P), history, False, "the residual diverged"
         normals = op.normals(P)
-        ab = _jacobian_bands(op, P, kappa, normals, JACOBIAN_STEP)
+        bands = _jacobian_bands(op, P, kappa, normals, JACOBIAN_STEP, rows, closed)
         try:
-            delta = solve_banded((1, 1), ab, -residual)
+            delta = _solve_jacobian(bands, -residual, closed)
         except np.linalg.LinAlgError:
             history.append((errf, float("nan")))
-            return curve.with_control_points(P), history, False, "the Jacobian is singular"
+            return build(P), history, False, "the Jacobian is singular"
         errx = float(np.sum(np.abs(delta)))
         history.append((errf, errx))
         if not np.all(np.isfinite(delta)) or np.max(np.abs(delta)) > MAX_STEP:
-            return curve.with_control_points(P), history, False, (
+            return build(P), history, False, (
                 f"a step of {np.max(np.abs(delta)):.3g} exceeds {MAX_STEP} of the reference length (diverging)"
             )
-        P[1:-1] += delta[:, None] * normals
+        P[rows] += delta[:, None] * normals
         if progress is not None:
             progress(iteration, int(max_iterations))
         if errx <= tolx:
             kappa = op.curvature(P)
             history.append((float(np.sum(np.abs(kappa - target))), 0.0))
-            return curve.with_control_points(P), history, True, "tolx"
-    return curve.with_control_points(P), history, False, f"ntrial = {max_iterations} iterations reached"
+            return build(P), history, True, "tolx"
+    return build(P), history, False, f"ntrial = {max_iterations} iterations reached"
 
 
 # =======================================================================================
@@ -473,26 +680,63 @@ def _run(
     settings: SmoothingSettings,
     progress: Progress | None,
     rescale_chord: Callable[[BSplineCurve, BSplineCurve], tuple[BSplineCurve, float]] | None = None,
+    closed: bool = False,
 ):
-    """Redistribute, interpolate, smooth the curvature, iterate (reference length 1)."""
+    """Redistribute, interpolate, smooth the curvature, iterate (reference length 1).
+    closed: ``fractions`` run from 0 to 1 with the last point repeating the first; the
+    curve is periodic (no end conditions, nothing fixed at the seam)."""
     table = arclength_table(source)
     u_src = params_at_arclength(source, fractions, table)
     r = derivatives(source, u_src, 0)[0]
     report = distribution_report(derivatives(source, params_at_arclength(source, output_fractions, table), 0)[0])
-    unsmoothed, params = spline_through(r, settings.end_derivative_order)
-    op = _KnotCurvature.of(unsmoothed, params)
+    if closed:
+        unsmoothed, params = periodic_spline_through(r[:-1])
+    else:
+        unsmoothed, params = spline_through(r, settings.end_derivative_order)
+    op = _KnotCurvature.of(unsmoothed, params, closed)
     kappa0 = op.curvature(unsmoothed.control_points)
     target = smooth_curvature(
-        kappa0, settings.smoother, settings.passes, settings.smoothing_type, settings.smoothing_weight
+        kappa0, settings.smoother, settings.passes, settings.smoothing_type, settings.smoothing_weight, closed
     )
+    if closed:
+        target = _keep_turning(target, kappa0, unsmoothed, params)
     curve, history, converged, reason = newton_curvature(
-        unsmoothed, params, target, settings.max_iterations, settings.tolx, settings.tolf, progress
+        unsmoothed, params, target, settings.max_iterations, settings.tolx, settings.tolf, progress, closed
     )
+    if closed:
+        curve = _rigid_align(curve, unsmoothed, params)
     chord_scale = 1.0
     if converged and rescale_chord is not None:
         curve, chord_scale = rescale_chord(curve, unsmoothed)
     kappa1 = op.curvature(curve.control_points)
     return unsmoothed, params, curve, kappa0, target, kappa1, history, converged, reason, report, chord_scale
+
+
+def _keep_turning(target: np.ndarray, kappa: np.ndarray, curve: BSplineCurve, params: np.ndarray) -> np.ndarray:
+    """κ* shifted by a constant so that it turns the tangent as far as κ does around the
+    loop (∮κ ds = 2π for a simple closed curve; trapezoidal rule over the knots, arc
+    lengths of ``curve``). Smoothing in the point index does not conserve ∮κ ds when the
+    points are not evenly spaced, and a closed curve cannot absorb the difference at free
+    ends: it would bend its whole shape to meet κ* at the knots."""
+    t, s = arclength_table(curve)
+    knots_s = np.interp(np.concatenate([params, [curve.domain[1]]]), t, s)
+    ds = np.diff(knots_s)
+    w = 0.5 * (ds + np.roll(ds, 1))  # trapezoid weights of the periodic knots
+    return target + float(np.sum(w * (kappa - target))) / float(np.sum(w))
+
+
+def _rigid_align(curve: BSplineCurve, reference: BSplineCurve, params: np.ndarray) -> BSplineCurve:
+    """``curve`` moved by the rotation and translation that best map its knot points onto
+    ``reference``'s (least squares, Kabsch/Procrustes). A closed curve is held by nothing
+    but its curvature, which does not see rigid motions: the Newton steps drift along them
+    (near-null vectors of the cyclic Jacobian). Curvature is unchanged by the move."""
+    A, B = curve.evaluate(params), reference.evaluate(params)
+    ca, cb = A.mean(axis=0), B.mean(axis=0)
+    H = (A - ca).T @ (B - cb)
+    U, _, Vt = np.linalg.svd(H)
+    D = np.diag([1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
+    R = Vt.T @ D @ U.T
+    return curve.with_control_points(cb + (curve.control_points - ca) @ R.T)
 
 
 def _fail(kind: str, history, reason: str):
@@ -531,12 +775,18 @@ def smooth2d(
     progress: Progress | None = None,
     raise_on_failure: bool = True,
     measure: bool = True,
+    closed: bool | None = None,
 ) -> SmoothingResult:
     """Hvid's smooth2D (1993 §3.3): smooth any plane curve.
 
     data: (m, 2) points (interpolated first, §3.2 step 1) or a 2-D BSplineCurve (used as it
-    is when its degree is at least 2; a polyline's vertices are interpolated). Closed curves
-    are smoothed as open ones whose two ends stay fixed.
+    is when its degree is at least 2; a polyline's vertices are interpolated).
+    closed: None detects a closed curve (last point, or end, within
+    :data:`CLOSED_TOL` of the size from the first). Closed curves are smoothed as periodic
+    ones: periodic interpolation of ``smoothing_points`` distinct points, curvature
+    smoothed around the loop, every control point free (cyclic tridiagonal Jacobian), so
+    the seam is not fixed and leaves no trace. The result is a periodic cubic (unclamped
+    knots, last three control points repeating the first three).
     alpha: damping α of the curvature-weighted distribution (:func:`curvature_fractions`).
     Raises :class:`SmoothingNotConverged` (with the residual history) when the iteration
     fails, unless ``raise_on_failure`` is False.
@@ -555,16 +805,25 @@ def smooth2d(
     if ref <= 0:
         raise GeometryError("smooth2D: the curve has zero extent")
     eye = np.eye(2)
+    if closed is None:
+        ends = raw.evaluate(np.array(raw.domain)) if raw is not None else points[[0, -1]]
+        closed = bool(np.linalg.norm(ends[1] - ends[0]) <= CLOSED_TOL * ref)
     if raw is not None:
         source = _transform_curve(raw, 1.0 / ref, eye, -lo / ref)
         data_points = source.evaluate(span_samples(source, 1))
     else:
         data_points = (points - lo) / ref
-        source, _ = spline_through(data_points, settings.end_derivative_order)
-    fractions = curvature_fractions(source, settings.smoothing_points, alpha)
+        if closed:
+            if np.linalg.norm(data_points[-1] - data_points[0]) <= CLOSED_TOL:
+                data_points = data_points[:-1]
+            source, _ = periodic_spline_through(data_points)
+        else:
+            source, _ = spline_through(data_points, settings.end_derivative_order)
+    # closed: one more fraction, the last (= 1) repeating the first point of the loop
+    fractions = curvature_fractions(source, settings.smoothing_points + int(closed), alpha)
     output_fractions = curvature_fractions(source, settings.output_points, alpha)
     (unsmoothed, params, curve, k0, target, k1, history, converged, reason, report, _) = _run(
-        source, fractions, output_fractions, settings, progress
+        source, fractions, output_fractions, settings, progress, closed=closed
     )
     if not converged and raise_on_failure:
         _fail("smooth2D", history, reason)

@@ -9,10 +9,11 @@ bpy = pytest.importorskip("bpy")
 AIRFOILS = pathlib.Path(__file__).resolve().parents[3] / "shared" / "data" / "airfoils"
 
 
-def _poly_object(points3, name="profile"):
+def _poly_object(points3, name="profile", cyclic=False):
     data = bpy.data.curves.new(name, "CURVE")
     data.dimensions = "3D"
     spline = data.splines.new("POLY")
+    spline.use_cyclic_u = cyclic
     spline.points.add(len(points3) - 1)
     rows = np.ones((len(points3), 4))
     rows[:, :3] = points3
@@ -67,6 +68,22 @@ def test_smooth_tilted_poly_curve(scene):
     co = np.array([p.co[:3] for p in smoothed.data.splines[0].points])
     normal = np.cross(e1, e2)
     assert np.abs(co @ normal).max() < 1e-5  # stays in the curve's plane
+
+
+def test_smooth_cyclic_poly_curve(scene):
+    """A cyclic (closed) noisy ellipse: smoothed as a periodic curve, the result closed."""
+    t = np.linspace(0, 2 * np.pi, 121)[:-1]
+    rng = np.random.default_rng(2)
+    xy = np.stack([2 * np.cos(t), np.sin(t)], 1) + rng.uniform(-5e-4, 5e-4, (120, 2))
+    _poly_object(np.column_stack([xy, np.zeros(120)]), "loop", cyclic=True)
+    assert bpy.ops.bladesmith.smooth_curve(
+        kind="CURVE", alpha=100.0, smoothing_points=120, smoother="least_squares", smoothing_weight=1.0, smoothing_type="1"
+    ) == {"FINISHED"}
+    smoothed = bpy.data.objects["loop smoothed"]
+    assert smoothed["bladesmith_fairing"]["converged"]
+    co = np.array([p.co[:3] for p in smoothed.data.splines[0].points])
+    assert np.allclose(co[0], co[-1], atol=1e-6)  # closed (Bezier form: first = last)
+    assert np.abs(np.hypot(co[:, 0] / 2, co[:, 1]) - 1).max() < 0.05  # still the ellipse
 
 
 def test_non_convergence_leaves_scene_unchanged(scene):
