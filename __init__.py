@@ -8,16 +8,27 @@ import importlib
 #: Registered in this order, unregistered in reverse.
 _SUBMODULES = ("operators", "ui")
 
+#: Registered instead when scipy cannot be imported: preferences and a panel that say so,
+#: and the operators as disabled stand-ins (ui/dependencies.py).
+_WITHOUT_SCIPY = ("ui.dependencies",)
 
-def _modules():
-    return [importlib.import_module(f".{name}", __package__) for name in _SUBMODULES]
+_registered = []
+
+
+def _modules(names=_SUBMODULES):
+    return [importlib.import_module(f".{name}", __package__) for name in names]
 
 
 def register():
-    for module in _modules():
+    from .ui.dependencies import scipy_problem
+
+    modules = _modules(_SUBMODULES if scipy_problem() is None else _WITHOUT_SCIPY)
+    for module in modules:
         module.register()
+    _registered[:] = modules
 
 
 def unregister():
-    for module in reversed(_modules()):
+    for module in reversed(_registered or _modules()):
         module.unregister()
+    _registered.clear()

@@ -104,7 +104,19 @@ def legacy_surface_parameters(knots, order, n_points, resolution, cyclic):
 
 
 def curve_parameters(knots, order, n_points, resolution, cyclic):
-    """Blender's curve samples (bke::curves::nurbs::calculate_basis_cache, 4.5)."""
+    """Blender's curve samples (bke::curves::nurbs::calculate_basis_cache, 4.5).
+
+    Blender 5.0 puts ``resolution`` evenly spaced samples in each non-empty knot span of the
+    domain, and the end point of an open curve; 4.5 spreads resolution * segments samples
+    evenly over the whole domain.
+    """
+    if bpy.app.version >= (5, 0, 0):
+        k = np.asarray(knots, dtype=np.float64)
+        start = k[order - 1]
+        end = k[n_points + order - 1] if cyclic else k[n_points]
+        breaks = np.unique(k[(k >= start) & (k <= end)])
+        spans = [a + (b - a) * np.arange(resolution) / resolution for a, b in zip(breaks[:-1], breaks[1:])]
+        return np.concatenate(spans + ([] if cyclic else [[end]]))
     k = knots.astype(np.float32)
     count = resolution * (n_points if cyclic else n_points - 1)
     start = k[order - 1]
