@@ -20,6 +20,7 @@ import numpy as np
 
 from ..geometry.errors import BladesmithError, GeometryError, IgesError
 from ..geometry.nurbs import BSplineCurve, BSplineSurface
+from ..geometry.nurbs.operations import split_surface
 from .records import (
     BSplineCurve126,
     BSplineSurface128,
@@ -391,6 +392,53 @@ def to_geometry(record: Entity):
             raise
         raise IgesError(f"{record.describe()}: {exc}") from None
     raise IgesError(f"{record.describe()}: has no curve or surface geometry")
+
+
+# -- surfaces as pieces readers take as they are ---------------------------------------------
+#: Boundary iso-curves closer than this fraction of the surface's size make it closed.
+CLOSED_TOL = 1e-9
+#: Points compared along each boundary to decide closedness.
+CLOSED_SAMPLES = 33
+
+
+def _closed(surface: BSplineSurface, direction: str) -> bool:
+    (a, b), (c, d) = surface.domain_u, surface.domain_v
+    if direction == "u":
+        t = np.linspace(c, d, CLOSED_SAMPLES)
+        A, B = surface.evaluate(a, t), surface.evaluate(b, t)
+    else:
+        t = np.linspace(a, b, CLOSED_SAMPLES)
+        A, B = surface.evaluate(t, c), surface.evaluate(t, d)
+    return float(np.abs(A - B).max()) <= CLOSED_TOL * surface.size()
+
+
+def surface_pieces(surface: BSplineSurface) -> list[BSplineSurface]:
+    """``surface`` as the pieces a reader takes without repair, exactly (knot insertion).
+
+    OpenCASCADE makes a closed surface periodic ("Surface is made periodic") and reports
+    a surface that is only C0 across an interior knot ("Resulting Geom_Surface is
+    C0-continuous"), both as warnings. So a surface is cut at every interior knot of
+    multiplicity >= its degree (degree 2 and up; degree 1 is C0 everywhere) and, where it
+    is closed in a direction with no such cut, in the middle of that direction. Returns
+    ``[surface]`` when nothing needs cutting.
+    """
+    pieces = [surface]
+    for direction in ("u", "v"):
+        out = []
+        for piece in pieces:
+            p, U = (piece.degree_u, piece.knots_u) if direction == "u" else (piece.degree_v, piece.knots_v)
+            a, b = piece.domain_u if direction == "u" else piece.domain_v
+            values, counts = np.unique(U[(U > a) & (U < b)], return_counts=True)
+            cuts = list(values[counts >= p]) if p >= 2 else []
+            if not cuts and _closed(piece, direction):
+                cuts = [0.5 * (a + b)]
+            rest = piece
+            for x in cuts:
+                first, rest = split_surface(rest, direction, float(x))
+                out.append(first)
+            out.append(rest)
+        pieces = out
+    return pieces
 
 
 # -- geometry -> records ------------------------------------------------------------------

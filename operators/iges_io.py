@@ -5,7 +5,9 @@ from their exact float64 data, hand-edited or native Blender NURBS, poly and Bez
 from their Blender data with the knot vectors Blender really uses
 (:func:`..operators.nurbs_objects.object_to_geometry`). Object transforms are applied to
 the control points (NURBS are affine invariant, so this is exact up to the float32
-matrix Blender stores; identity transforms are skipped and cost nothing).
+matrix Blender stores; identity transforms are skipped and cost nothing). Surfaces that
+are closed, or only C0 across a knot, are written in exact pieces
+(:func:`..iges.convert.surface_pieces`): OpenCASCADE would otherwise repair them and warn.
 
 A tip-smoothed propeller (any of its objects selected, or all) is written the way
 Hally (2013) §11 prescribes instead of object by object: the five surfaces of the
@@ -37,7 +39,7 @@ from ..iges import (
     surface_from_geometry,
     write_iges,
 )
-from ..iges.convert import surface_points, surface_range
+from ..iges.convert import surface_pieces, surface_points, surface_range
 from .nurbs_objects import curve_to_object, object_to_geometry, surface_to_object
 from .progress import progress_callback
 
@@ -127,6 +129,8 @@ def export_objects(objects, filepath: str, units: str = "M", progress=None) -> d
             pieces = _world_geometry(obj)
         except BladesmithError as exc:
             raise type(exc)(f"object '{obj.name}': {exc}") from None
+        # closed or C0 surfaces go out in pieces, which readers take without repair
+        pieces = [q for g in pieces for q in (surface_pieces(g) if isinstance(g, BSplineSurface) else [g])]
         for k, g in enumerate(pieces):
             label = obj.name if len(pieces) == 1 else f"{obj.name}.{k}"
             if isinstance(g, BSplineSurface):

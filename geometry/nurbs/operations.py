@@ -566,6 +566,25 @@ def split(curve: BSplineCurve, u: float) -> tuple[BSplineCurve, BSplineCurve]:
     return left, right
 
 
+def split_surface(surface: BSplineSurface, direction: str, value: float) -> tuple[BSplineSurface, BSplineSurface]:
+    """Cut ``surface`` at ``value`` of ``direction`` ('u' or 'v') into two surfaces, as
+    :func:`split` cuts a curve (NURBS Book Alg. A5.1 on every row of the net at once);
+    both pieces are clamped in that direction, over [a, value] and [value, b]."""
+    surface = _require_surface(surface)
+    axis = _axis(direction)
+    p, U = _surface_parts(surface, axis)
+    U, net = _clamp_net(U, p, _surface_net(surface, axis))
+    a, b = _domain(U, p)
+    u = _knot_value(U, p, value, "split parameter")
+    if not a < u < b:
+        raise GeometryError(f"split parameter {u!r} must be strictly inside the domain ({a!r}, {b!r})")
+    U, net = _insert_knot_net(U, p, net, u, p - _multiplicity(U, u))
+    lo = int(np.searchsorted(U, u, side="left"))  # the p copies of u are U[lo:lo+p]
+    left = _surface_with(surface, axis, p, np.concatenate([U[: lo + p], [u]]), net[:lo])
+    right = _surface_with(surface, axis, p, np.concatenate([[u], U[lo:]]), net[lo - 1 :])
+    return left, right
+
+
 def _map_knots(U: np.ndarray, p: int, domain) -> np.ndarray:
     try:
         c, d = (float(x) for x in domain)

@@ -612,3 +612,26 @@ def test_core_evaluates_end_of_unclamped_curve_with_multiple_end_knot():
     with np.errstate(all="ignore"):
         end = c.evaluate(5.0)
     np.testing.assert_allclose(end, clamp(c).control_points[-1], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("direction", ["u", "v"])
+@pytest.mark.parametrize("rational", [False, True])
+def test_split_surface_reproduces_the_surface(direction, rational):
+    from bladesmith.geometry.nurbs.operations import split_surface
+
+    rng = np.random.default_rng(61 + rational)
+    for kind in ("clamped", "unclamped"):
+        s = random_surface(rng, 3, 2, kind, kind, rational)
+        (a, b), (c, d) = s.domain_u, s.domain_v
+        lo, hi = (a, b) if direction == "u" else (c, d)
+        x = lo + 0.37 * (hi - lo)
+        first, second = split_surface(s, direction, x)
+        t = rng.uniform(0, 1, 400)
+        for piece, (p0, p1) in ((first, (lo, x)), (second, (x, hi))):
+            w = p0 + t * (p1 - p0)
+            other = (c + rng.uniform(0, 1, 400) * (d - c)) if direction == "u" else (a + rng.uniform(0, 1, 400) * (b - a))
+            uu, vv = (w, other) if direction == "u" else (other, w)
+            assert np.abs(piece.evaluate(uu, vv) - s.evaluate(uu, vv)).max() < 1e-12 * s.size()
+        # the pieces share their boundary row of control points exactly
+        axis = 0 if direction == "u" else 1
+        assert np.array_equal(np.take(first.control_points, -1, axis), np.take(second.control_points, 0, axis))
