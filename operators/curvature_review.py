@@ -1,0 +1,957 @@
+"""Curvature review in Blender: ``bpy.ops.bladesmith.curvature_review`` and
+:func:`render_review_image`.
+
+Everything is computed from the exact float64 model of each reviewed object
+(:func:`.nurbs_objects.object_to_geometry`), never from Blender's tessellation:
+
+- **maps**: per surface spline a mesh object ``<source> map`` built from the surface's own
+  grid (uniform per knot span, :func:`~..geometry.fairing.review.surface_map`), with the
+  chosen quantity in the float attribute ``bladesmith_value`` and its colour in the colour
+  attribute ``bladesmith_curvature`` (diverging blue-white-orange map, symmetric limits
+  from a percentile of |value| over everything reviewed in the run). The mesh is lifted by
+  :data:`DISPLAY_OFFSET_FRACTION` of the object's size along the normal so it does not
+  z-fight with the source in the viewport; the values are those of the exact surface.
+  Linked duplicates (the copies of a propeller blade) get objects sharing the same mesh.
+- **combs**: ``<source> combs``, a curve object of poly splines: per comb the teeth
+  (base, tip, base, next base, ...) and the envelope. Iso lines of surfaces use the normal
+  curvature against the surface normal, curve objects their signed in-plane curvature
+  when planar (:func:`~..geometry.fairing.surface_curvature.curvature_comb`).
+- **legend**: a colour bar mesh and black text meshes (limits, quantity, units, clipping).
+- **numbers**: per surface, stored on its map object as ``bladesmith_review`` (JSON) and
+  shown by :mod:`..ui.review_panel`.
+- **comparison**: with ``reference`` (an object or collection name: the geometry before
+  smoothing) the reference is reviewed with the same limits and shown shifted by
+  -spacing along x, and a difference map (signed closest-point deviation in metres) of
+  each reviewed surface from the nearest reference surface is shown at +spacing.
+
+All review objects live in the collection :data:`REVIEW_COLLECTION` and are owned by it:
+running the operator again updates them in place (objects not produced by the new run are
+removed), and deleting the collection with its objects leaves the scene as it was. The
+reviewed objects, the selection and the active object are never touched.
+"""
+
+import json
+import math
+import os
+import tempfile
+import time
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
+from mathutils import Matrix, Vector
+
+from ..geometry.errors import BladesmithError, GeometryError
+from ..geometry.fairing.review import DEFAULT_SAMPLES_PER_SPAN, surface_map, surface_numbers
+from ..geometry.fairing.surface_curvature import (
+    DEFAULT_PERCENTILE,
+    comb_scale,
+    curvature_comb,
+    diverging_colours,
+    iso_line_comb,
+    signed_deviation,
+    symmetric_limits,
+)
+from ..geometry.nurbs import BSplineCurve, BSplineSurface
+from .nurbs_objects import object_to_geometry
+
+REVIEW_COLLECTION = "Bladesmith Review"
+#: Custom property on every review object: {"role": ..., "source": ..., "index": ...}.
+ROLE_KEY = "bladesmith_review_role"
+#: Custom property (JSON text) with a map object's numbers (SurfaceNumbers.as_dict()).
+NUMBERS_KEY = "bladesmith_review"
+#: Custom property on the collection (JSON): quantity, limits, units, clipped fraction.
+SETTINGS_KEY = "bladesmith_review_settings"
+VALUE_ATTRIBUTE = "bladesmith_value"
+COLOUR_ATTRIBUTE = "bladesmith_curvature"
+#: Maps are lifted along the normal by this fraction of the object's size (display only).
+DISPLAY_OFFSET_FRACTION = 1e-4
+#: Fairness integrals in the review: Gauss nodes per knot span (the MVS of surfaces with
+#: collapsed corners is dominated by the corners either way; 4 keeps the review fast).
+REVIEW_QUADRATURE_POINTS = 4
+#: Legend layout, as fractions of the bar's width: bar height and text size. The legend
+#: spans y from -LEGEND_BELOW to +LEGEND_ABOVE (times the width) about the bar's bottom.
+LEGEND_BAR_HEIGHT = 0.03
+LEGEND_TEXT_SIZE = 0.022
+LEGEND_BELOW = 0.03
+LEGEND_ABOVE = 0.065
+#: Comb tube radius as a fraction of the reviewed size (so combs show in renders).
+COMB_BEVEL_FRACTION = 5e-4
+
+QUANTITY_ITEMS = (
+    ("mean", "Mean", "Mean curvature H (1/m)"),
+    ("gaussian", "Gaussian", "Gaussian curvature K (1/m²)"),
+    ("k1", "Maximum principal", "κ1 (1/m)"),
+    ("k2", "Minimum principal", "κ2 (1/m)"),
+    ("max_abs", "Largest principal", "The principal curvature of larger magnitude (1/m)"),
+    ("strain_energy", "Strain energy density", "κ1² + κ2² (1/m²)"),
+    ("mvs", "MVS density", "(∂κ1/∂e1)² + (∂κ2/∂e2)² (1/m⁴)"),
+)
+LABELS = {
+    "mean": ("mean curvature H", "1/m"), "gaussian": ("Gaussian curvature K", "1/m²"),
+    "k1": ("principal curvature κ1", "1/m"), "k2": ("principal curvature κ2", "1/m"),
+    "max_abs": ("largest principal curvature", "1/m"), "strain_energy": ("κ1² + κ2²", "1/m²"),
+    "mvs": ("MVS density", "1/m⁴"), "deviation": ("deviation from reference", "m"),
+}
+
+
+# ---------------------------------------------------------------------------------------
+# objects owned by the review collection
+# ---------------------------------------------------------------------------------------
+def review_collection(scene, create: bool = True):
+    coll = bpy.data.collections.get(REVIEW_COLLECTION)
+    if coll is not None and coll.name not in scene.collection.children:
+        if create:
+            scene.collection.children.link(coll)
+    if coll is None and create:
+        coll = bpy.data.collections.new(REVIEW_COLLECTION)
+        scene.collection.children.link(coll)
+    return coll
+
+
+def _role(obj) -> tuple | None:
+    r = obj.get(ROLE_KEY)
+    return None if r is None else tuple(json.loads(r))
+
+
+class _Registry:
+    """The review objects of the collection by role key; those not claimed in a run are
+    removed at the end (:meth:`prune`)."""
+
+    def __init__(self, collection):
+        self.collection = collection
+        self.existing = {}
+        for obj in collection.objects:
+            key = _role(obj)
+            if key is not None:
+                self.existing[key] = obj
+        self.claimed = set()
+
+    def get(self, key: tuple, data_type: str, name: str, new_data):
+        """The object for ``key`` with data of type ``data_type`` (new or reused)."""
+        self.claimed.add(key)
+        obj = self.existing.get(key)
+        if obj is not None and obj.type == data_type and obj.name in bpy.data.objects:
+            return obj
+        if obj is not None:
+            _remove_object(obj)
+        data = new_data(name) if new_data is not None else None
+        obj = bpy.data.objects.new(name, data)
+        obj[ROLE_KEY] = json.dumps(list(key))
+        self.collection.objects.link(obj)
+        self.existing[key] = obj
+        return obj
+
+    def prune(self):
+        for key, obj in list(self.existing.items()):
+            if key not in self.claimed:
+                _remove_object(obj)
+                del self.existing[key]
+
+
+def _remove_object(obj) -> None:
+    data = obj.data
+    bpy.data.objects.remove(obj)
+    if data is not None and data.users == 0:
+        if isinstance(data, bpy.types.Mesh):
+            bpy.data.meshes.remove(data)
+        elif isinstance(data, bpy.types.Curve):
+            bpy.data.curves.remove(data)
+
+
+def clear_review(scene=None) -> None:
+    """Delete the review collection, its objects and their data (what the user does by
+    deleting the collection in the outliner)."""
+    coll = bpy.data.collections.get(REVIEW_COLLECTION)
+    if coll is None:
+        return
+    for obj in list(coll.all_objects):
+        _remove_object(obj)
+    bpy.data.collections.remove(coll)
+
+
+def _write_mesh(mesh, vertices: np.ndarray, quads: np.ndarray, colours: np.ndarray | None = None,
+                values: np.ndarray | None = None) -> None:
+    """Replace the mesh's geometry by vertices (n, 3), quads (m, 4), optional sRGB
+    colours (n, 4) and float values (n,) on the points. When the vertex and quad counts
+    are unchanged (a re-run), only positions, colours and values are rewritten.
+
+    Written through the generic attributes (``position``, ``.corner_vert``): their
+    foreach_set is a raw copy, unlike the legacy ``vertices.co``/``loops.vertex_index``."""
+    same = len(mesh.vertices) == len(vertices) and len(mesh.polygons) == len(quads) and len(quads) > 0 \
+        and mesh.get("bladesmith_topology") == _topology_key(quads)
+    if not same:
+        mesh.clear_geometry()
+        mesh.vertices.add(len(vertices))
+        if len(quads):
+            mesh.loops.add(quads.size)
+            mesh.polygons.add(len(quads))
+            mesh.attributes[".corner_vert"].data.foreach_set("value", quads.astype(np.int32).ravel())
+            mesh.polygons.foreach_set("loop_start", (np.arange(len(quads)) * 4).astype(np.int32))
+        mesh["bladesmith_topology"] = _topology_key(quads)
+    mesh.attributes["position"].data.foreach_set("vector", vertices.astype(np.float32).ravel())
+    mesh.update(calc_edges=not same)
+    if colours is not None:
+        attr = mesh.color_attributes.get(COLOUR_ATTRIBUTE)
+        if attr is None:
+            attr = mesh.color_attributes.new(COLOUR_ATTRIBUTE, "FLOAT_COLOR", "POINT")
+        attr.data.foreach_set("color", _srgb_to_linear(colours).astype(np.float32).ravel())
+        mesh.color_attributes.active_color = attr
+        mesh.color_attributes.render_color_index = mesh.color_attributes.find(COLOUR_ATTRIBUTE)
+    if values is not None:
+        attr = mesh.attributes.get(VALUE_ATTRIBUTE)
+        if attr is None:
+            attr = mesh.attributes.new(VALUE_ATTRIBUTE, "FLOAT", "POINT")
+        attr.data.foreach_set("value", values.astype(np.float32).ravel())
+
+
+def _topology_key(quads: np.ndarray) -> str:
+    """A cheap signature of a quad list (count and a few entries) for in-place updates."""
+    if len(quads) == 0:
+        return "0"
+    q = quads.ravel()
+    return f"{len(quads)}:{int(q[:64].sum())}:{int(q[-64:].sum())}:{int(q[:: max(1, q.size // 97)].sum())}"
+
+
+def _srgb_to_linear(rgba: np.ndarray) -> np.ndarray:
+    """sRGB-encoded RGBA to linear (IEC 61966-2-1), alpha unchanged: FLOAT_COLOR attributes
+    store linear values, and the raw ``color`` path of foreach_set is far faster than
+    ``color_srgb``."""
+    out = np.array(rgba, dtype=np.float64)
+    c = out[..., :3]
+    out[..., :3] = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return out
+
+
+def _new_mesh(name):
+    return bpy.data.meshes.new(name)
+
+
+def _new_comb_curve(name):
+    data = bpy.data.curves.new(name, "CURVE")
+    data.dimensions = "3D"
+    return data
+
+
+def _write_combs(curve_data, combs, bevel: float, envelope: bool) -> None:
+    curve_data.splines.clear()
+    curve_data.bevel_depth = bevel
+    curve_data.bevel_resolution = 0
+    for comb in combs:
+        base, tip = comb.points, comb.teeth
+        n = len(base)
+        # base_i, tip_i, base_i, base_i+1, ... draws every tooth and the curve in one spline
+        path = np.empty((3 * n - 1, 3))
+        path[0::3] = base
+        path[1::3] = tip
+        path[2::3] = base[:-1]
+        polylines = [path] + ([tip] if envelope else [])
+        for line in polylines:
+            spline = curve_data.splines.new("POLY")
+            spline.points.add(len(line) - 1)
+            co = np.ones((len(line), 4))
+            co[:, :3] = line
+            spline.points.foreach_set("co", co.astype(np.float32).ravel())
+
+
+# ---------------------------------------------------------------------------------------
+# text and legend (meshes with a black colour attribute, so they read in renders)
+# ---------------------------------------------------------------------------------------
+def _text_mesh(body: str, name: str, size: float, mesh=None):
+    """A mesh of ``body`` in the xy plane (height ~ size), black via its colour attribute."""
+    font = bpy.data.curves.new(name + " font", "FONT")
+    font.body = body
+    font.size = size
+    tmp = bpy.data.objects.new(name + " tmp", font)
+    try:
+        new = bpy.data.meshes.new_from_object(tmp)
+    finally:
+        bpy.data.objects.remove(tmp)
+        bpy.data.curves.remove(font)
+    if mesh is not None:
+        # keep the data-block identity for idempotent updates
+        verts = np.zeros(len(new.vertices) * 3)
+        new.vertices.foreach_get("co", verts)
+        loops = np.zeros(len(new.loops), dtype=np.int32)
+        new.loops.foreach_get("vertex_index", loops)
+        starts = np.zeros(len(new.polygons), dtype=np.int32)
+        totals = np.zeros(len(new.polygons), dtype=np.int32)
+        new.polygons.foreach_get("loop_start", starts)
+        new.polygons.foreach_get("loop_total", totals)
+        bpy.data.meshes.remove(new)
+        mesh.clear_geometry()
+        mesh.vertices.add(len(verts) // 3)
+        mesh.vertices.foreach_set("co", verts)
+        mesh.loops.add(len(loops))
+        mesh.loops.foreach_set("vertex_index", loops)
+        mesh.polygons.add(len(starts))
+        mesh.polygons.foreach_set("loop_start", starts)
+        mesh.update(calc_edges=True)
+        new = mesh
+    else:
+        new.name = name
+    for a in list(new.color_attributes):
+        new.color_attributes.remove(a)
+    attr = new.color_attributes.new(COLOUR_ATTRIBUTE, "FLOAT_COLOR", "POINT")
+    black = np.zeros((len(new.vertices), 4), dtype=np.float32)
+    black[:, 3] = 1.0
+    attr.data.foreach_set("color", black.ravel())
+    new.color_attributes.active_color = attr
+    return new
+
+
+def _format(x: float) -> str:
+    return f"{x:.3g}"
+
+
+def legend_lines(settings: dict) -> tuple[str, list[tuple[float, str]]]:
+    """Title and (position 0..1, label) ticks of the legend of ``settings``."""
+    name, units = LABELS.get(settings["quantity"], (settings["quantity"], ""))
+    lo, hi = settings["limits"]
+    title = f"{name} ({units})"
+    if settings.get("percentile", 100) < 100:
+        title += f", limits at the {settings['percentile']:g}th area percentile of |value|"
+        title += f" ({100 * settings.get('clipped', 0):.1f}% of the area beyond)"
+    ticks = [(t, _format(lo + t * (hi - lo))) for t in (0.0, 0.25, 0.5, 0.75, 1.0)]
+    return title, ticks
+
+
+def build_legend(registry_or_collection, settings: dict, placement: Matrix, width: float, tag: str = "legend"):
+    """Colour bar and labels laid out in the local xy plane of ``placement`` (bar from x = 0
+    to ``width``, labels below, title above). Returns the objects."""
+    registry = registry_or_collection if isinstance(registry_or_collection, _Registry) else None
+    collection = registry.collection if registry else registry_or_collection
+    h = LEGEND_BAR_HEIGHT * width
+    n = 64
+    x = np.linspace(0.0, width, n + 1)
+    verts = np.concatenate([np.stack([x, np.zeros_like(x), np.zeros_like(x)], -1),
+                            np.stack([x, np.full_like(x, h), np.zeros_like(x)], -1)])
+    idx = np.arange(n)
+    quads = np.stack([idx, idx + 1, idx + n + 2, idx + n + 1], -1)
+    lo, hi = settings["limits"]
+    values = np.tile(lo + (hi - lo) * x / width, 2)
+    colours = diverging_colours(values, (lo, hi))
+    objects = []
+
+    def obtain(key, name, new_data):
+        if registry:
+            return registry.get(key, "MESH", name, new_data)
+        obj = bpy.data.objects.new(name, new_data(name))
+        collection.objects.link(obj)
+        return obj
+
+    bar = obtain((tag, "bar"), "Review legend bar", _new_mesh)
+    _write_mesh(bar.data, verts, quads, colours)
+    bar.matrix_world = placement
+    objects.append(bar)
+    title, ticks = legend_lines(settings)
+    size = LEGEND_TEXT_SIZE * width
+    texts = [(title, Matrix.Translation((0.0, h + 0.35 * size, 0.0)))]
+    for t, label in ticks:
+        texts.append((label, Matrix.Translation((t * width - 0.27 * size * len(label), -1.0 * size, 0.0))))
+    for i, (body, offset) in enumerate(texts):
+        obj = obtain((tag, "text", i), f"Review legend text {i}", None if registry else (lambda nm: None))
+        if obj.type != "MESH" or obj.data is None:
+            # a fresh object without data: give it a text mesh (objects cannot change type)
+            bpy.data.objects.remove(obj)
+            mesh = _text_mesh(body, f"Review legend text {i}", size)
+            obj = bpy.data.objects.new(f"Review legend text {i}", mesh)
+            if registry:
+                obj[ROLE_KEY] = json.dumps([tag, "text", i])
+                registry.existing[(tag, "text", i)] = obj
+            collection.objects.link(obj)
+        else:
+            _text_mesh(body, obj.name, size, mesh=obj.data)
+        obj.matrix_world = placement @ offset
+        objects.append(obj)
+    return objects
+
+
+# ---------------------------------------------------------------------------------------
+# the review
+# ---------------------------------------------------------------------------------------
+def review_sources(objects) -> list:
+    """CURVE and SURFACE objects to review: the given ones, and the descendants of given
+    Empties (a propeller's root), in a stable order without repeats."""
+    out, seen = [], set()
+
+    def add(obj):
+        if obj.name in seen:
+            return
+        seen.add(obj.name)
+        if obj.type in {"CURVE", "SURFACE"}:
+            out.append(obj)
+        if obj.type == "EMPTY":
+            for child in sorted(obj.children, key=lambda o: o.name):
+                add(child)
+
+    for obj in objects:
+        add(obj)
+    return out
+
+
+def _collection_objects(name: str) -> list:
+    if not name:
+        return []
+    obj = bpy.data.objects.get(name)
+    if obj is not None:
+        return [obj]
+    coll = bpy.data.collections.get(name)
+    if coll is not None:
+        return sorted(coll.all_objects, key=lambda o: o.name)
+    raise GeometryError(f"reference {name!r} is neither an object nor a collection")
+
+
+@dataclass
+class ReviewOptions:
+    """Options of :func:`review_objects` (the operator's properties)."""
+
+    quantity: str = "mean"
+    percentile: float = DEFAULT_PERCENTILE
+    limit: float = 0.0
+    samples_per_span: int = DEFAULT_SAMPLES_PER_SPAN
+    convex_positive: bool = True
+    comb_lines: int = 2
+    comb_teeth: int = 100
+    comb_scale: float = 0.0
+    comb_sign: float = 1.0
+    envelope: bool = True
+    iso_lines: int = 11
+    quadrature_points: int = REVIEW_QUADRATURE_POINTS
+    numbers: bool = True
+    legend: bool = True
+    reference: str = ""
+    spacing: float = 0.0
+
+
+@dataclass
+class ReviewResult:
+    maps: list = field(default_factory=list)
+    combs: list = field(default_factory=list)
+    numbers: dict = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
+    times: dict = field(default_factory=dict)
+
+
+def _geometry(obj):
+    try:
+        return object_to_geometry(obj)
+    except GeometryError as error:
+        raise GeometryError(f"{obj.name}: {error}") from None
+
+
+def review_objects(scene, objects, options: ReviewOptions | None = None, **kwargs) -> ReviewResult:
+    """Review ``objects`` (see the module docstring) into the review collection of
+    ``scene``; returns the numbers, settings and stage times. Raises BladesmithError
+    (nothing is created then) for unusable input."""
+    opt = options or ReviewOptions(**kwargs)
+    if opt.quantity not in LABELS or opt.quantity == "deviation":
+        raise GeometryError(f"unknown quantity {opt.quantity!r}")
+    clock = time.perf_counter()
+    times = {}
+    sources = review_sources(objects)
+    references = review_sources(_collection_objects(opt.reference))
+    references = [r for r in references if r.name not in {s.name for s in sources}]
+    if not sources:
+        raise GeometryError("nothing to review: select curve or surface objects (or a propeller)")
+    sign = -1.0 if opt.convex_positive else 1.0  # convex (outward normals) positive
+    # ---- compute (bpy-free work; nothing is created until everything succeeded)
+    groups = {}  # data -> [objects] (linked duplicates share one review)
+    for obj in sources + references:
+        groups.setdefault(obj.data.name + "\0" + obj.type, []).append(obj)
+    computed = []  # (role, owner object, duplicates, surface or curve, index, map)
+    for key, objs in groups.items():
+        owner = objs[0]
+        role = "reference" if owner in references else "source"
+        for index, entity in enumerate(_geometry(owner)):
+            if isinstance(entity, BSplineSurface):
+                if entity.dim != 3:
+                    continue
+                m = surface_map(entity, opt.quantity, opt.samples_per_span, sign)
+                computed.append((role, owner, objs, entity, index, m))
+            elif isinstance(entity, BSplineCurve) and role == "source":
+                computed.append((role, owner, objs, entity, index, None))
+    times["maps"] = time.perf_counter() - clock
+    maps = [c for c in computed if c[5] is not None]
+    values = [c[5].values for c in maps]
+    if values:
+        areas = [c[5].vertex_areas() for c in maps]
+        limits = (-opt.limit, opt.limit) if opt.limit > 0 else symmetric_limits(values, opt.percentile, areas)
+        v_all = np.concatenate([v.ravel() for v in values])
+        a_all = np.concatenate([a.ravel() for a in areas])
+        outside = (v_all < limits[0]) | (v_all > limits[1])
+        clipped = float(a_all[outside].sum() / max(a_all.sum(), 1e-300))  # fraction of the area
+    else:
+        limits = (-1.0, 1.0)
+        clipped = 0.0
+    # combs: iso lines of surfaces and the curves themselves, one scale for all
+    raw_combs = []
+    teeth = max(int(opt.comb_teeth), 2)
+    for role, owner, objs, entity, index, m in computed:
+        if role != "source":
+            continue
+        if m is None:
+            raw_combs.append((owner, curvature_comb(entity, teeth, scale=1.0, sign=opt.comb_sign)))
+        elif opt.comb_lines > 0:
+            for direction, (lo, hi) in (("u", entity.domain_u), ("v", entity.domain_v)):
+                for value in np.linspace(lo, hi, opt.comb_lines + 2)[1:-1]:
+                    raw_combs.append((owner, iso_line_comb(entity, direction, float(value), teeth, scale=1.0,
+                                                           sign=opt.comb_sign * (1 if sign > 0 else -1))))
+    size = _world_size([c[1] for c in computed])
+    scale = opt.comb_scale if opt.comb_scale > 0 else comb_scale([c.curvature for _, c in raw_combs], size) if raw_combs else 0.0
+    times["combs"] = time.perf_counter() - clock - times["maps"]
+    numbers = {}
+    if opt.numbers:
+        for role, owner, objs, entity, index, m in maps:
+            label = f"{owner.name}" + (f" [{index}]" if index else "")
+            numbers[(owner.name, index)] = surface_numbers(
+                entity, label, curvature=m.curvature, iso_lines=opt.iso_lines,
+                quadrature_points=opt.quadrature_points)
+    times["numbers"] = time.perf_counter() - clock - times["maps"] - times["combs"]
+    deviation = {}
+    spacing = opt.spacing if opt.spacing > 0 else 1.2 * size
+    if references:
+        ref_surfaces = [c[3] for c in maps if c[0] == "reference"]
+        for c in maps:
+            if c[0] != "source":
+                continue
+            pts = c[5].points.reshape(-1, 3)
+            best = None
+            for ref in ref_surfaces:
+                d = signed_deviation(pts, ref)
+                best = d if best is None else np.where(np.abs(d) < np.abs(best), d, best)
+            deviation[(c[1].name, c[4])] = best.reshape(c[5].values.shape)
+    times["comparison"] = time.perf_counter() - clock - sum(times.values())
+    # ---- write Blender objects
+    write_clock = time.perf_counter()
+    coll = review_collection(scene)
+    registry = _Registry(coll)
+    result = ReviewResult(settings={"quantity": opt.quantity, "limits": list(limits), "percentile": opt.percentile
+                                    if opt.limit <= 0 else 100.0, "clipped": clipped, "sign": sign,
+                                    "comb_scale": scale, "sources": [s.name for s in sources],
+                                    "reference": opt.reference})
+    shift = {"source": Vector((0.0, 0.0, 0.0)), "reference": Vector((-spacing, 0.0, 0.0))}
+    for role, owner, objs, entity, index, m in maps:
+        offset = DISPLAY_OFFSET_FRACTION * max(entity.size(), 1e-12)
+        verts = (m.points + offset * m.curvature.normal).reshape(-1, 3)
+        quads = m.quads()
+        colours = diverging_colours(m.values.ravel(), limits)
+        first = None
+        for k, obj in enumerate(objs):
+            name = f"{obj.name} map" + (f" {index}" if index else "")
+            key = ("map", role, obj.name, index)
+            if first is None:
+                target = registry.get(key, "MESH", name, _new_mesh)
+                _write_mesh(target.data, verts, quads, colours, m.values.ravel())
+                first = target
+                n = numbers.get((owner.name, index))
+                target[NUMBERS_KEY] = json.dumps(n.as_dict()) if n is not None else "{}"
+            else:
+                target = registry.get(key, "MESH", name, _new_mesh)
+                if target.data is not first.data:
+                    old = target.data
+                    target.data = first.data
+                    if old.users == 0:
+                        bpy.data.meshes.remove(old)
+            target.matrix_world = Matrix.Translation(shift[role]) @ obj.matrix_world
+            result.maps.append(target)
+        dev = deviation.get((owner.name, index))
+        if dev is not None:
+            dlim = symmetric_limits(dev, 100.0)
+            target = registry.get(("deviation", owner.name, index), "MESH", f"{owner.name} deviation", _new_mesh)
+            _write_mesh(target.data, verts, quads, diverging_colours(dev.ravel(), dlim), dev.ravel())
+            target["bladesmith_deviation_limits"] = list(dlim)
+            target.matrix_world = Matrix.Translation((spacing, 0.0, 0.0)) @ owner.matrix_world
+            result.maps.append(target)
+            result.settings.setdefault("deviation_max", 0.0)
+            result.settings["deviation_max"] = max(result.settings["deviation_max"], float(np.max(np.abs(dev))))
+    by_owner = {}
+    for owner, comb in raw_combs:
+        by_owner.setdefault(owner.name, (owner, []))[1].append(comb)
+    for name, (owner, combs) in by_owner.items():
+        scaled = [_rescale(c, scale) for c in combs]
+        target = registry.get(("combs", name), "CURVE", f"{name} combs", _new_comb_curve)
+        _write_combs(target.data, scaled, COMB_BEVEL_FRACTION * size, opt.envelope)
+        target.matrix_world = owner.matrix_world
+        result.combs.append(target)
+    if opt.legend and maps:
+        lo_corner, hi_corner = _world_bounds([c[1] for c in computed])
+        width = 0.6 * size
+        placement = Matrix.Translation((lo_corner[0], lo_corner[1], lo_corner[2] - 0.15 * size)) @ Matrix.Rotation(
+            math.pi / 2, 4, "X")
+        build_legend(registry, result.settings, placement, width)
+    registry.prune()
+    coll[SETTINGS_KEY] = json.dumps(result.settings)
+    result.numbers = {f"{k[0]}" + (f" [{k[1]}]" if k[1] else ""): v for k, v in numbers.items()}
+    times["write"] = time.perf_counter() - write_clock
+    times["total"] = time.perf_counter() - clock
+    result.times = times
+    return result
+
+
+def _rescale(comb, scale: float):
+    from dataclasses import replace
+
+    teeth = comb.points - (comb.sign * scale * comb.curvature)[:, None] * comb.reference
+    return replace(comb, teeth=teeth, scale=scale)
+
+
+def _world_bounds(objects):
+    lo = np.full(3, np.inf)
+    hi = np.full(3, -np.inf)
+    for obj in objects:
+        M = np.array(obj.matrix_world)
+        corners = np.array([list(c) + [1.0] for c in obj.bound_box]) @ M.T
+        lo = np.minimum(lo, corners[:, :3].min(axis=0))
+        hi = np.maximum(hi, corners[:, :3].max(axis=0))
+    if not np.all(np.isfinite(lo)):
+        return np.zeros(3), np.ones(3)
+    return lo, hi
+
+
+def _world_size(objects) -> float:
+    lo, hi = _world_bounds(objects)
+    return float(max(np.linalg.norm(hi - lo), 1e-9))
+
+
+# ---------------------------------------------------------------------------------------
+# the review image
+# ---------------------------------------------------------------------------------------
+def _look_at(position: np.ndarray, target: np.ndarray, up: np.ndarray) -> Matrix:
+    forward = target - position
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, up)
+    right /= np.linalg.norm(right)
+    true_up = np.cross(right, forward)
+    R = np.column_stack([right, true_up, -forward])
+    M = Matrix.Identity(4)
+    for i in range(3):
+        for j in range(3):
+            M[i][j] = R[i, j]
+        M[i][3] = position[i]
+    return M
+
+
+def _map_points(maps) -> tuple[np.ndarray, np.ndarray, list]:
+    """World points and normals of the map meshes (sampled), and each map's mean normal."""
+    P, N, means = [], [], []
+    for obj in maps:
+        mesh = obj.data
+        co = np.zeros(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", co)
+        co = co.reshape(-1, 3).astype(np.float64)[::7]
+        nrm = np.zeros(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("normal", nrm)
+        nrm = nrm.reshape(-1, 3).astype(np.float64)[::7]
+        M = np.array(obj.matrix_world)
+        P.append(co @ M[:3, :3].T + M[:3, 3])
+        n = nrm @ M[:3, :3].T
+        N.append(n)
+        means.append(n.mean(axis=0))
+    return np.concatenate(P), np.concatenate(N), means
+
+
+def _orthonormal_views(P: np.ndarray, span: np.ndarray, side: np.ndarray, names) -> list[dict]:
+    """Pressure/suction views along ±side (orthogonalised against span, which is up) and a
+    three-quarter tip close-up, framed on the points P (world)."""
+    span = span / np.linalg.norm(span)
+    side = side - span * np.dot(side, span)
+    side /= np.linalg.norm(side)
+    chord = np.cross(side, span)
+    proj_s, proj_c = P @ span, P @ chord
+    ext_s, ext_c = np.ptp(proj_s), np.ptp(proj_c)
+    mid = span * 0.5 * (proj_s.max() + proj_s.min()) + chord * 0.5 * (proj_c.max() + proj_c.min())
+    mid = mid + side * np.mean(P @ side)
+    scale = 1.1 * max(ext_s, ext_c)
+    dist = 4.0 * scale
+    tip_point = P[np.argmax(proj_s)]
+    tip_centre = tip_point - span * 0.12 * ext_s
+    tip_dir = side * 0.9 + span * 0.35
+    tip_dir /= np.linalg.norm(tip_dir)
+    return [
+        {"title": names[0], "matrix": _look_at(mid + side * dist, mid, span), "ortho_scale": scale},
+        {"title": names[1], "matrix": _look_at(mid - side * dist, mid, span), "ortho_scale": scale},
+        {"title": "tip close-up", "matrix": _look_at(tip_centre + tip_dir * dist, tip_centre, span),
+         "ortho_scale": 0.4 * max(ext_s, ext_c)},
+    ]
+
+
+def review_views(maps) -> list[dict]:
+    """The three fixed views: pressure side, suction side and a tip close-up.
+
+    For a Bladesmith propeller blade (maps of objects tagged ``bladesmith_part = "blade"``
+    under a root Empty) the span is the radial direction from the root's axis (its local
+    z) and the side the mean normal of the pressure surface (patch 0). Otherwise: span is
+    the principal axis of largest extent, the side the one of smallest, named front/back."""
+    def source_of(obj):
+        key = _role(obj)
+        return bpy.data.objects.get(key[2]) if key and key[0] == "map" else None
+
+    # frame the reference blade when the maps are a Bladesmith propeller's (copies and hub
+    # still show in the views; they are rendered, only not framed)
+    blade = [o for o in maps if source_of(o) is not None and source_of(o).get("bladesmith_part") == "blade"
+             and int(source_of(o).get("bladesmith_blade", 0)) == 0]
+    P, _, _ = _map_points(blade or maps)
+    for obj in blade or maps:
+        key = _role(obj)
+        source = bpy.data.objects.get(key[2]) if key and key[0] == "map" else None
+        if source is None or source.get("bladesmith_part") != "blade" or source.get("bladesmith_patch") != 0:
+            continue
+        root = source.parent
+        M = np.array(root.matrix_world) if root is not None else np.eye(4)
+        axis, origin = M[:3, 2] / np.linalg.norm(M[:3, 2]), M[:3, 3]
+        radial = P.mean(axis=0) - origin
+        radial -= axis * np.dot(radial, axis)
+        side = _map_points([obj])[2][0]
+        return _orthonormal_views(P, radial, side, ("pressure side", "suction side"))
+    centre = P.mean(axis=0)
+    _, _, Vt = np.linalg.svd(P - centre, full_matrices=False)
+    return _orthonormal_views(P, Vt[0], Vt[2], ("front", "back"))
+
+
+def _render(scene, path: str) -> None:
+    scene.render.filepath = path
+    bpy.ops.render.render(write_still=True, scene=scene.name)
+
+
+def _read_png(path: str) -> np.ndarray:
+    img = bpy.data.images.load(path, check_existing=False)
+    try:
+        w, h = img.size
+        px = np.zeros(w * h * 4, dtype=np.float32)
+        img.pixels.foreach_get(px)
+        return px.reshape(h, w, 4)
+    finally:
+        bpy.data.images.remove(img)
+
+
+def _write_png(pixels: np.ndarray, path: str) -> None:
+    h, w = pixels.shape[:2]
+    img = bpy.data.images.new("bladesmith review composite", w, h, alpha=False)
+    try:
+        img.pixels.foreach_set(pixels.astype(np.float32).ravel())
+        folder = os.path.dirname(os.path.abspath(path))
+        fd, tmp = tempfile.mkstemp(suffix=".png", dir=folder)
+        os.close(fd)
+        try:
+            img.filepath_raw = tmp
+            img.file_format = "PNG"
+            img.save()
+            os.chmod(tmp, 0o644)  # mkstemp makes it private; the image is for sharing
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+            raise
+    finally:
+        bpy.data.images.remove(img)
+
+
+def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend_height: int = 150,
+                        scene=None, review: bool = True, samples: str = "FXAA", **review_options) -> dict:
+    """Write a PNG with three Workbench views (pressure side, suction side, tip close-up)
+    of the curvature maps of ``objects`` and a legend strip below them.
+
+    ``review``: run :func:`review_objects` first (with ``review_options``), else use the
+    maps already in the review collection. The render happens in a temporary scene that
+    holds only linked copies of the maps (the user's scene, its objects, camera and
+    settings are untouched) and is removed afterwards with everything made for it. The
+    file is written atomically. Returns {"filepath", "views", "times"}."""
+    scene = scene or bpy.context.scene
+    clock = time.perf_counter()
+    times = {}
+    if review:
+        review_objects(scene, objects, **review_options)
+    coll = review_collection(scene, create=False)
+    if coll is None:
+        raise GeometryError("no curvature review to render: run the review first")
+    settings = json.loads(coll.get(SETTINGS_KEY, "{}"))
+    maps = [o for o in coll.objects if (_role(o) or ("",))[0] == "map" and _role(o)[1] == "source"]
+    if not maps:
+        raise GeometryError("the review has no surface maps to render")
+    times["review"] = time.perf_counter() - clock
+    views = review_views(maps)
+    made_objects, made_meshes = [], []
+    temp = bpy.data.scenes.new("Bladesmith review render")
+    world = bpy.data.worlds.new("Bladesmith review world")
+    camera_data = bpy.data.cameras.new("Bladesmith review camera")
+    folder = tempfile.mkdtemp(prefix="bladesmith_review_")
+    try:
+        world.color = (1.0, 1.0, 1.0)
+        temp.world = world
+        temp.render.engine = "BLENDER_WORKBENCH"
+        shading = temp.display.shading
+        # flat light keeps the map's colours true to the legend; outline and cavity
+        # (ridges and valleys) give the shape
+        shading.light = "FLAT"
+        shading.color_type = "VERTEX"
+        shading.show_object_outline = True
+        shading.object_outline_color = (0.1, 0.1, 0.1)
+        shading.show_cavity = True
+        shading.cavity_type = "WORLD"
+        temp.display.render_aa = samples
+        temp.view_settings.view_transform = "Standard"
+        temp.view_settings.look = "None"
+        temp.render.film_transparent = False
+        temp.render.image_settings.file_format = "PNG"
+        temp.render.image_settings.color_mode = "RGB"
+        temp.render.resolution_percentage = 100
+        for obj in maps:
+            copy = bpy.data.objects.new(obj.name + " render", obj.data)
+            copy.matrix_world = obj.matrix_world
+            temp.collection.objects.link(copy)
+            made_objects.append(copy)
+        cam = bpy.data.objects.new("Bladesmith review camera", camera_data)
+        temp.collection.objects.link(cam)
+        made_objects.append(cam)
+        temp.camera = cam
+        camera_data.type = "ORTHO"
+        temp.render.resolution_x = temp.render.resolution_y = int(panel_size)
+        panels = []
+        title_obj = None
+        for i, view in enumerate(views):
+            cam.matrix_world = view["matrix"]
+            s = view["ortho_scale"]
+            camera_data.ortho_scale = s
+            camera_data.clip_start = 1e-3 * s
+            camera_data.clip_end = 100.0 * s
+            if title_obj is not None:
+                temp.collection.objects.unlink(title_obj)
+            mesh = _text_mesh(view["title"], f"Bladesmith review title {i}", 0.055 * s)
+            made_meshes.append(mesh)
+            title_obj = bpy.data.objects.new(f"Bladesmith review title {i}", mesh)
+            made_objects.append(title_obj)
+            title_obj.matrix_world = view["matrix"] @ Matrix.Translation((-0.46 * s, 0.42 * s, -0.05 * s))
+            temp.collection.objects.link(title_obj)
+            path = os.path.join(folder, f"view{i}.png")
+            _render(temp, path)
+            panels.append(_read_png(path))
+        times["views"] = time.perf_counter() - clock - times["review"]
+        # legend strip: its own small render, far from the maps
+        for obj in list(temp.collection.objects):
+            if obj is not cam:
+                temp.collection.objects.unlink(obj)
+        width = 1.0
+        legend_objs = build_legend(temp.collection, settings, Matrix.Identity(4), width, tag="render legend")
+        made_objects.extend(legend_objs)
+        made_meshes.extend(o.data for o in legend_objs)
+        total_w = panel_size * len(views)
+        temp.render.resolution_x = total_w
+        temp.render.resolution_y = int(legend_height)
+        shading.light = "FLAT"  # the bar shows the map's colours exactly
+        s = max(1.12 * width, (LEGEND_BELOW + LEGEND_ABOVE) * width * 1.15 * total_w / legend_height)
+        camera_data.ortho_scale = s
+        centre = np.array([0.5 * width, 0.5 * (LEGEND_ABOVE - LEGEND_BELOW) * width, 0.0])
+        cam.matrix_world = _look_at(centre + np.array([0.0, 0.0, 2.0]), centre, np.array([0.0, 1.0, 0.0]))
+        camera_data.clip_start, camera_data.clip_end = 1e-3, 10.0
+        path = os.path.join(folder, "legend.png")
+        _render(temp, path)
+        legend = _read_png(path)
+        image = np.concatenate([legend, np.concatenate(panels, axis=1)], axis=0)  # rows run bottom-up
+        for k in range(1, len(views)):  # thin separators between the panels
+            image[legend.shape[0]:, k * panel_size - 1 : k * panel_size + 1, :3] = 0.6
+        _write_png(image, filepath)
+        times["legend_and_write"] = time.perf_counter() - clock - times["review"] - times["views"]
+    finally:
+        for obj in made_objects:
+            if obj.name in bpy.data.objects:
+                bpy.data.objects.remove(obj)
+        for mesh in made_meshes:
+            if mesh.name in bpy.data.meshes and mesh.users == 0:
+                bpy.data.meshes.remove(mesh)
+        bpy.data.scenes.remove(temp)
+        bpy.data.worlds.remove(world)
+        bpy.data.cameras.remove(camera_data)
+        for name in os.listdir(folder):
+            os.remove(os.path.join(folder, name))
+        os.rmdir(folder)
+    times["total"] = time.perf_counter() - clock
+    return {"filepath": filepath, "views": [v["title"] for v in views], "times": times}
+
+
+# ---------------------------------------------------------------------------------------
+# operators
+# ---------------------------------------------------------------------------------------
+class BLADESMITH_OT_curvature_review(bpy.types.Operator):
+    """Curvature combs, curvature maps and fairness numbers of the selected curves and
+    surfaces (and propellers), in the "Bladesmith Review" collection"""
+
+    bl_idname = "bladesmith.curvature_review"
+    bl_label = "Curvature Review"
+    bl_options = {"REGISTER", "UNDO"}
+
+    quantity: EnumProperty(name="Quantity", items=QUANTITY_ITEMS, default="mean")
+    percentile: FloatProperty(name="Clip Percentile", default=DEFAULT_PERCENTILE, min=50.0, max=100.0,
+                              description="Colour limits: this percentile of |value| (robust against tips and edges)")
+    limit: FloatProperty(name="Limit", default=0.0, min=0.0,
+                         description="Symmetric colour limit; 0 for the percentile")
+    samples_per_span: IntProperty(name="Samples per Span", default=DEFAULT_SAMPLES_PER_SPAN, min=1, max=64)
+    convex_positive: BoolProperty(name="Convex Positive", default=True,
+                                  description="Curvature positive where the surface bulges along its normal "
+                                              "(Bladesmith normals point outwards)")
+    comb_lines: IntProperty(name="Comb Lines", default=2, min=0, max=50,
+                            description="Iso lines per surface and direction that get a comb")
+    comb_teeth: IntProperty(name="Comb Density", default=100, min=2, max=2000, description="Teeth per comb")
+    comb_scale: FloatProperty(name="Comb Scale", default=0.0, min=0.0,
+                              description="Tooth length per unit curvature (m²); 0 for automatic")
+    comb_inside: BoolProperty(name="Teeth Inside", default=False,
+                              description="Draw teeth towards the centre of curvature (default: convex side)")
+    envelope: BoolProperty(name="Envelope", default=True)
+    iso_lines: IntProperty(name="Counted Iso Lines", default=11, min=0, max=200)
+    reference: StringProperty(name="Reference", default="",
+                              description="Object or collection before smoothing: same limits, and a difference map")
+    filepath: StringProperty(name="Review Image", default="", subtype="FILE_PATH",
+                             description="Also render a review image (PNG) to this path")
+
+    @classmethod
+    def poll(cls, context):
+        return any(o.type in {"CURVE", "SURFACE", "EMPTY"} for o in context.selected_objects)
+
+    def execute(self, context):
+        options = ReviewOptions(
+            quantity=self.quantity, percentile=self.percentile, limit=self.limit,
+            samples_per_span=self.samples_per_span, convex_positive=self.convex_positive,
+            comb_lines=self.comb_lines, comb_teeth=self.comb_teeth, comb_scale=self.comb_scale,
+            comb_sign=-1.0 if self.comb_inside else 1.0, envelope=self.envelope, iso_lines=self.iso_lines,
+            reference=self.reference,
+        )
+        wm = context.window_manager
+        wm.progress_begin(0, 2)
+        try:
+            result = review_objects(context.scene, list(context.selected_objects), options)
+            wm.progress_update(1)
+            if self.filepath:
+                render_review_image([], bpy.path.abspath(self.filepath), scene=context.scene, review=False)
+        except BladesmithError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        space = getattr(context, "space_data", None)
+        if space is not None and space.type == "VIEW_3D":
+            space.shading.color_type = "VERTEX"  # show the colour attribute in Solid mode
+        lo, hi = result.settings["limits"]
+        self.report({"INFO"}, f"reviewed {len(result.maps)} maps, {len(result.combs)} comb objects; "
+                              f"limits ±{hi:.3g}, {result.times['total'] * 1e3:.0f} ms")
+        return {"FINISHED"}
+
+
+class BLADESMITH_OT_clear_curvature_review(bpy.types.Operator):
+    """Delete the "Bladesmith Review" collection and everything in it"""
+
+    bl_idname = "bladesmith.clear_curvature_review"
+    bl_label = "Clear Curvature Review"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return REVIEW_COLLECTION in bpy.data.collections
+
+    def execute(self, context):
+        clear_review(context.scene)
+        return {"FINISHED"}
+
+
+_classes = (BLADESMITH_OT_curvature_review, BLADESMITH_OT_clear_curvature_review)
+register, unregister = bpy.utils.register_classes_factory(_classes)

@@ -1,0 +1,135 @@
+"""The curvature review operator: maps, combs, legend and numbers from the exact model,
+idempotent re-runs, scene safety, comparison, and one small review image."""
+import json
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+from bladesmith.geometry.nurbs import BSplineSurface, clamped_uniform_knots, interpolate  # noqa: E402
+from bladesmith.operators import curvature_review as cr  # noqa: E402
+from bladesmith.operators.nurbs_objects import curve_to_object, object_to_geometry, surface_to_object  # noqa: E402
+
+
+@pytest.fixture(scope="module", autouse=True)
+def review_registered(addon):
+    """The review operator and panel are registered with the add-on."""
+    assert hasattr(bpy.types, "BLADESMITH_OT_curvature_review")
+
+
+def bump_surface(height=0.05):
+    n = 8
+    x = np.linspace(0.0, 1.0, n)
+    P = np.zeros((n, n, 3))
+    P[..., 0], P[..., 1] = np.meshgrid(x, 0.5 * x, indexing="ij")
+    P[..., 2] = height * np.outer(np.sin(np.pi * x), np.sin(np.pi * x))
+    k = clamped_uniform_knots(n, 3)
+    return BSplineSurface(3, 3, k, k, P)
+
+
+def snapshot(scene):
+    out = {}
+    for obj in scene.objects:
+        data = obj.data
+        pts = None
+        if obj.type in {"CURVE", "SURFACE"}:
+            pts = [tuple(p.co) for s in data.splines for p in s.points]
+        out[obj.name] = (obj.type, tuple(map(tuple, obj.matrix_world)), pts, obj.select_get(), dict(obj.items()).keys())
+    active = bpy.context.view_layer.objects.active
+    return out, active.name if active else None, sorted(c.name for c in bpy.data.collections)
+
+
+def make_scene():
+    surf = surface_to_object(bump_surface(), "Bump")
+    t = np.linspace(0, 1, 20)
+    curve = curve_to_object(interpolate(np.stack([t, 0.2 * np.sin(2 * np.pi * t), 0 * t], -1), 3), "Cut")
+    for o in (surf, curve):
+        o.select_set(True)
+    bpy.context.view_layer.objects.active = surf
+    return surf, curve
+
+
+def test_review_maps_combs_numbers_idempotent_and_safe(scene):
+    surf, curve = make_scene()
+    before = snapshot(scene)
+    assert bpy.ops.bladesmith.curvature_review(quantity="gaussian", comb_lines=2, comb_teeth=30) == {"FINISHED"}
+    coll = bpy.data.collections[cr.REVIEW_COLLECTION]
+    names = sorted(o.name for o in coll.objects)
+    assert "Bump map" in names and "Bump combs" in names and "Cut combs" in names
+    m = coll.objects["Bump map"]
+    # the colour attribute carries the exact curvature at the map's vertices
+    S = object_to_geometry(surf)[0]
+    us = np.unique(S.knots_u)
+    vals = np.zeros(len(m.data.vertices), dtype=np.float32)
+    m.data.attributes[cr.VALUE_ATTRIBUTE].data.foreach_get("value", vals)
+    from bladesmith.geometry.fairing.review import surface_map
+
+    ref = surface_map(S, "gaussian")
+    assert np.allclose(vals, ref.values.ravel().astype(np.float32), rtol=1e-6, atol=1e-6 * np.abs(ref.values).max())
+    assert m.data.color_attributes.active_color.name == cr.COLOUR_ATTRIBUTE
+    numbers = json.loads(m[cr.NUMBERS_KEY])
+    c = ref.curvature
+    assert numbers["k_max"] == pytest.approx(float(c.k1.max())) or numbers["k_max"] == pytest.approx(float(-c.k2.min()))
+    assert len(numbers["iso_lines"]) == 2 and len(numbers["iso_lines"][0]["counts"]) == 11
+    assert len(us) > 1
+    # idempotent: the same objects and data-blocks are updated
+    ids = {o.name: o.data.name for o in coll.objects}
+    n_meshes, n_curves = len(bpy.data.meshes), len(bpy.data.curves)
+    assert bpy.ops.bladesmith.curvature_review(quantity="mean", comb_lines=2, comb_teeth=30) == {"FINISHED"}
+    assert {o.name: o.data.name for o in coll.objects} == ids
+    assert (len(bpy.data.meshes), len(bpy.data.curves)) == (n_meshes, n_curves)
+    assert len([c for c in bpy.data.collections if c.name.startswith(cr.REVIEW_COLLECTION)]) == 1
+    # the reviewed geometry, selection and active object are untouched
+    after = snapshot(scene)
+    assert {k: after[0][k] for k in before[0]} == before[0] and after[1] == before[1]
+    assert set(after[0]) - set(before[0]) == {o.name for o in coll.objects}
+    # deleting the collection leaves the scene as it was
+    cr.clear_review(scene)
+    assert snapshot(scene) == before
+    assert not [me for me in bpy.data.meshes if me.users == 0]
+
+
+def test_comparison_same_limits_and_deviation(scene):
+    smooth = surface_to_object(bump_surface(0.05), "After")
+    surface_to_object(bump_surface(0.052), "Before")
+    smooth.select_set(True)
+    bpy.context.view_layer.objects.active = smooth
+    assert bpy.ops.bladesmith.curvature_review(reference="Before", comb_lines=0) == {"FINISHED"}
+    coll = bpy.data.collections[cr.REVIEW_COLLECTION]
+    names = {o.name for o in coll.objects}
+    assert {"After map", "Before map", "After deviation"} <= names
+    settings = json.loads(coll[cr.SETTINGS_KEY])
+    # the deviation is the closest-point distance: at most the 2 mm bump difference
+    dev = coll.objects["After deviation"]
+    d = np.zeros(len(dev.data.vertices), dtype=np.float32)
+    dev.data.attributes[cr.VALUE_ATTRIBUTE].data.foreach_get("value", d)
+    assert 0.0015 < np.abs(d).max() <= 0.002 + 1e-6
+    assert settings["deviation_max"] == pytest.approx(float(np.abs(d).max()), rel=1e-5)
+    assert coll.objects["Before map"].matrix_world.translation.x < -0.5
+
+
+def test_errors_leave_the_scene_unchanged(scene):
+    empty = bpy.data.objects.new("Lonely", None)
+    scene.collection.objects.link(empty)
+    empty.select_set(True)
+    with pytest.raises(RuntimeError, match="nothing to review"):  # reported ERROR, returned CANCELLED
+        bpy.ops.bladesmith.curvature_review()
+    assert cr.REVIEW_COLLECTION not in bpy.data.collections
+
+
+def test_review_image(scene, tmp_path):
+    surf, _ = make_scene()
+    path = tmp_path / "review.png"
+    before = snapshot(scene)
+    out = cr.render_review_image([surf], str(path), panel_size=160, legend_height=60, comb_lines=0)
+    assert path.stat().st_size > 1000
+    assert out["views"] == ["front", "back", "tip close-up"]
+    img = bpy.data.images.load(str(path))
+    try:
+        assert tuple(img.size) == (480, 220)
+    finally:
+        bpy.data.images.remove(img)
+    assert len(bpy.data.scenes) == 1 and bpy.context.scene == scene
+    cr.clear_review(scene)
+    assert snapshot(scene) == before
