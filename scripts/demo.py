@@ -93,6 +93,16 @@ def main(argv=None) -> int:
         steps["IGES export"] = time.perf_counter() - t
         print(f"wrote {igs}")
 
+        from bladesmith.operators.curvature_review import render_review_image
+
+        image = out / "dtmb4119_review.png"
+        t = time.perf_counter()
+        # the five surfaces of the reference blade: the hub's curvature would set the limits
+        reference_blade = [obj for key, obj in parts.items() if key[0] == "blade" and key[2] == 0]
+        render_review_image(reference_blade, str(image), percentile=90.0)
+        steps["review image (curvature maps, 3 views)"] = time.perf_counter() - t
+        print(f"wrote {image}")
+
         for name, seconds in steps.items():
             print(f"  {name:40s} {seconds:7.2f} s")
     finally:
