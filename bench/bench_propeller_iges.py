@@ -2,16 +2,12 @@
 
 Times: the hub sector (C1 spine, Eqs. 51–58, footprint spline, area); building the IGES
 records; writing the file (validation + serialisation + atomic write); the blade
-smoothing when ``geometry/propeller/smoothing.py`` exists (else a stand-in of five
-bicubic patches is used and its time is shown but not counted as smoothing); and the whole
+smoothing (without its deviation measurement, which the file does not need); and the whole
 pipeline (definition -> model -> smoothing -> hub sector -> file), against the issue's 2 s
 budget. Baseline: writing the five blade surfaces alone (no hub), measured in the same run.
 """
 from __future__ import annotations
 
-import importlib
-import importlib.util
-import inspect
 import tempfile
 
 from common import ROOT, load_checkout, median_time, report
@@ -19,41 +15,18 @@ from common import ROOT, load_checkout, median_time, report
 BUDGET_S = 2.0
 
 
-def _blade_maker():
-    """(callable model -> blade surfaces, description)."""
-    try:
-        smoothing = importlib.import_module("bladesmith.geometry.propeller.smoothing")
-    except ImportError:
-        smoothing = None
-    if smoothing is not None:
-        fn = smoothing.smooth_blade
-        params = list(inspect.signature(fn).parameters.values())
-        if len(params) > 1 and params[1].default is inspect.Parameter.empty:
-            cls = next((getattr(smoothing, n) for n in ("SmoothingSettings", "Settings", "TipSmoothingSettings")
-                        if hasattr(smoothing, n)), None)
-            if cls is not None:
-                return (lambda m: fn(m, cls())), "smooth_blade"
-        else:
-            return fn, "smooth_blade"
-    tests = ROOT / "tests" / "iges" / "test_propeller_iges.py"
-    spec = importlib.util.spec_from_file_location("_propeller_iges_tests", tests)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.stand_in_blade, "stand-in (smoothing.py not there yet)"
-
-
 def main() -> dict:
     load_checkout()
-    import sys
-
-    sys.path.insert(0, str(ROOT / "tests" / "iges"))  # occ_support for the stand-in module's imports
-    from bladesmith.geometry.propeller import Propeller
+    from bladesmith.geometry.propeller import Propeller, smooth_blade
     from bladesmith.geometry.propeller.hub_sector import hub_sector
     from bladesmith.iges import surface_from_geometry, write_iges
     from bladesmith.iges.propeller import BLADE_SURFACES, propeller_iges_entities, write_propeller_iges
 
     path_toml = ROOT / "data" / "propellers" / "dtmb4119.toml"
-    make_blade, blade_kind = _blade_maker()
+    def make_blade(m):
+        return smooth_blade(m, measure=False)
+
+    blade_kind = "smooth_blade"
     model = Propeller.from_toml(path_toml).build()
     model.blade_hub_intersection
     blade = make_blade(model)

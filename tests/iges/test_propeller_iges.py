@@ -13,8 +13,6 @@ insertion) into five open patches, so their common edges coincide.
 """
 from __future__ import annotations
 
-import importlib
-import inspect
 import pathlib
 from types import SimpleNamespace
 
@@ -26,7 +24,7 @@ pytest.importorskip("OCP")
 from bladesmith.geometry.errors import GeometryError, IgesError  # noqa: E402
 from bladesmith.geometry.nurbs import BSplineSurface  # noqa: E402
 from bladesmith.geometry.nurbs.operations import refine_knots_surface  # noqa: E402
-from bladesmith.geometry.propeller import Propeller  # noqa: E402
+from bladesmith.geometry.propeller import Propeller, smooth_blade  # noqa: E402
 from bladesmith.geometry.propeller.hub_sector import hub_sector  # noqa: E402
 from bladesmith.iges import read_iges  # noqa: E402
 from bladesmith.iges.propeller import (  # noqa: E402
@@ -96,33 +94,13 @@ def stand_in_blade(model, a: float = 0.1, eta_split: float = 0.8, n_s: int = 97,
                            trailing_edge=te, tip=tip1)
 
 
-def smoothed_blade(model):
-    """The other engineer's smoothed blade when geometry/propeller/smoothing.py exists."""
-    try:
-        smoothing = importlib.import_module("bladesmith.geometry.propeller.smoothing")
-    except ImportError:
-        return None
-    fn = smoothing.smooth_blade
-    params = list(inspect.signature(fn).parameters.values())
-    if len(params) > 1 and params[1].default is inspect.Parameter.empty:
-        settings_cls = next((getattr(smoothing, n) for n in ("SmoothingSettings", "Settings", "TipSmoothingSettings")
-                             if hasattr(smoothing, n)), None)
-        if settings_cls is None:
-            pytest.skip("smooth_blade needs settings and no default settings class was found")
-        return fn(model, settings_cls())
-    return fn(model)
-
-
 BLADE_SOURCES = ("stand_in", "smoothed")
 
 
 def blade_surfaces(model, source):
     if source == "stand_in":
         return stand_in_blade(model)
-    blade = smoothed_blade(model)
-    if blade is None:
-        pytest.skip("geometry/propeller/smoothing.py (smooth_blade) does not exist yet")
-    return blade
+    return smooth_blade(model, measure=False)
 
 
 # -- fixtures -------------------------------------------------------------------------------------
