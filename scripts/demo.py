@@ -72,7 +72,7 @@ def main(argv=None) -> int:
         D = definition.diameter
         cuts, knots = report["cuts"], report["knots"]
         print(f"cuts: {cuts['tip']} tip, {cuts['leading_edge']} LE, {cuts['trailing_edge']} TE "
-              f"({cuts['smoothed']} smoothed), transition cut j = {report['transition_index']}; one knot vector for "
+              f"({cuts['smoothed']} smoothed), transition cut j = {report['transition_index'] + 1} (1-based); one knot vector for "
               f"{knots['curves']} curves: {knots['n_control']} control points each")
         dev = report["deviation_m"]
         print(f"deviation from the section-table blade: {dev['max_outside']:.2e} m outside the smoothing zone "
