@@ -54,7 +54,7 @@ from ..geometry.fairing.surface_curvature import (
     symmetric_limits,
 )
 from ..geometry.nurbs import BSplineCurve, BSplineSurface
-from .nurbs_objects import object_to_geometry
+from .nurbs_objects import object_to_geometry, remove_object
 
 REVIEW_COLLECTION = "Bladesmith Review"
 #: Custom property on every review object: {"role": ..., "source": ..., "index": ...}.
@@ -135,7 +135,7 @@ class _Registry:
         if obj is not None and obj.type == data_type and obj.name in bpy.data.objects:
             return obj
         if obj is not None:
-            _remove_object(obj)
+            remove_object(obj)
         data = new_data(name) if new_data is not None else None
         obj = bpy.data.objects.new(name, data)
         obj[ROLE_KEY] = json.dumps(list(key))
@@ -146,18 +146,8 @@ class _Registry:
     def prune(self):
         for key, obj in list(self.existing.items()):
             if key not in self.claimed:
-                _remove_object(obj)
+                remove_object(obj)
                 del self.existing[key]
-
-
-def _remove_object(obj) -> None:
-    data = obj.data
-    bpy.data.objects.remove(obj)
-    if data is not None and data.users == 0:
-        if isinstance(data, bpy.types.Mesh):
-            bpy.data.meshes.remove(data)
-        elif isinstance(data, bpy.types.Curve):
-            bpy.data.curves.remove(data)
 
 
 def clear_review(scene=None) -> None:
@@ -167,7 +157,7 @@ def clear_review(scene=None) -> None:
     if coll is None:
         return
     for obj in list(coll.all_objects):
-        _remove_object(obj)
+        remove_object(obj)
     bpy.data.collections.remove(coll)
 
 

@@ -40,7 +40,7 @@ from ..iges import (
     write_iges,
 )
 from ..iges.convert import surface_pieces, surface_points, surface_range
-from .nurbs_objects import curve_to_object, object_to_geometry, surface_to_object
+from .nurbs_objects import curve_to_object, object_to_geometry, remove_object, surface_to_object
 from .progress import progress_callback
 
 #: Trimming curves of an imported 144 are approximated on the surface to this fraction of
@@ -207,10 +207,7 @@ def import_file(filepath: str, collection, progress=None) -> dict:
                 progress((i + 1) / len(items))
     except BladesmithError:
         for obj in created:
-            data = obj.data
-            bpy.data.objects.remove(obj)
-            if data is not None and data.users == 0:
-                bpy.data.curves.remove(data)
+            remove_object(obj)
         raise
     counts["objects"] = created
     return counts

@@ -19,7 +19,7 @@ from bpy.props import BoolProperty, EnumProperty, StringProperty
 from ..geometry.compressor import ImpellerDefinition, blade_net, distribution, dumps_toml
 from ..geometry.compressor.export import impeller_surfaces
 from ..geometry.errors import BladesmithError, DefinitionError
-from .nurbs_objects import PROPERTY_KEY, surface_to_object, write_surface
+from .nurbs_objects import PROPERTY_KEY, remove_object, surface_to_object, write_surface
 
 PRESET_DIR = pathlib.Path(__file__).resolve().parent.parent / "data" / "impellers"
 ROOT_KEY = "bladesmith_impeller_root"
@@ -54,13 +54,6 @@ def net_to_mesh(net: np.ndarray, name: str, collection):
     obj = bpy.data.objects.new(name, mesh)
     collection.objects.link(obj)
     return obj
-
-
-def _remove(obj) -> None:
-    data = obj.data
-    bpy.data.objects.remove(obj)
-    if data is not None and data.users == 0:
-        (bpy.data.curves if isinstance(data, bpy.types.Curve) else bpy.data.meshes).remove(data)
 
 
 def _child(root, name: str, data, collection):
@@ -111,7 +104,7 @@ def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_
             wanted[copy_name] = obj
     for name, obj in existing.items():
         if name not in wanted:
-            _remove(obj)
+            remove_object(obj)
     if show_net:
         net = blade_net(model.blade.camber, distribution(41, 1.5, 1.5), distribution(11))
         obj = net_to_mesh(net, f"{root.name} net B", collection)

@@ -352,20 +352,35 @@ def write_curve(obj, curve: BSplineCurve, resolution: int = DEFAULT_CURVE_RESOLU
     _store(obj, curve)
 
 
+def remove_object(obj) -> None:
+    """Delete ``obj``, and its curve or mesh data when nothing else uses it."""
+    data = obj.data
+    bpy.data.objects.remove(obj, do_unlink=True)
+    if data is not None and data.users == 0:
+        if isinstance(data, bpy.types.Mesh):
+            bpy.data.meshes.remove(data)
+        elif isinstance(data, bpy.types.Curve):
+            bpy.data.curves.remove(data)
+
+
+def _new_object(name: str, kind: str, write, collection):
+    """A new object of curve ``kind`` filled by ``write(obj)`` and linked to ``collection``;
+    nothing is left behind when that fails."""
+    obj = bpy.data.objects.new(name, _new_curve_data(name, kind))
+    try:
+        write(obj)
+        _link(obj, collection)
+    except BaseException:
+        remove_object(obj)
+        raise
+    return obj
+
+
 def curve_to_object(curve: BSplineCurve, name: str, collection=None, resolution: int = DEFAULT_CURVE_RESOLUTION):
     """A new CURVE object showing ``curve`` exactly (:func:`write_curve`), linked to
     ``collection`` (the scene collection by default)."""
     order_from_degree(curve.degree)
-    data = _new_curve_data(name, "CURVE")
-    obj = bpy.data.objects.new(name, data)
-    try:
-        write_curve(obj, curve, resolution)
-        _link(obj, collection)
-    except BaseException:
-        bpy.data.objects.remove(obj)
-        bpy.data.curves.remove(data)
-        raise
-    return obj
+    return _new_object(name, "CURVE", lambda obj: write_curve(obj, curve, resolution), collection)
 
 
 def _resolution_pair(resolution) -> tuple[int, int]:
@@ -516,16 +531,7 @@ def surface_to_object(surface: BSplineSurface, name: str, collection=None, resol
     ``collection`` (the scene collection by default)."""
     order_from_degree(surface.degree_u)
     order_from_degree(surface.degree_v)
-    data = _new_curve_data(name, "SURFACE")
-    obj = bpy.data.objects.new(name, data)
-    try:
-        write_surface(obj, surface, resolution)
-        _link(obj, collection)
-    except BaseException:
-        bpy.data.objects.remove(obj)
-        bpy.data.curves.remove(data)
-        raise
-    return obj
+    return _new_object(name, "SURFACE", lambda obj: write_surface(obj, surface, resolution), collection)
 
 
 # -- Blender -> model -----------------------------------------------------------------------

@@ -60,7 +60,7 @@ from ..geometry.propeller import BladeSurface, Hub, Propeller, PropellerModel, d
 from ..geometry.propeller.definition import RADIAL_FIELDS
 from ..geometry.propeller.display import DISPLAY_TOLERANCE_FRACTION, blade_display_surface, hub_surface
 from .progress import progress_callback
-from .nurbs_objects import PROPERTY_KEY, write_surface
+from .nurbs_objects import PROPERTY_KEY, remove_object, write_surface
 
 #: The extension package (``bladesmith`` from a checkout, ``bl_ext.<repo>.bladesmith``
 #: when installed).
@@ -494,13 +494,6 @@ def _new_child(root, obj, part: str, patch: int, blade: int):
     return obj
 
 
-def _remove_object(obj) -> None:
-    data = obj.data
-    bpy.data.objects.remove(obj, do_unlink=True)
-    if data is not None and data.users == 0:
-        bpy.data.curves.remove(data)
-
-
 def _new_surface_child(root, surface, name, part, patch, resolution):
     data = bpy.data.curves.new(name, type="SURFACE")
     data.dimensions = "3D"
@@ -509,7 +502,7 @@ def _new_surface_child(root, surface, name, part, patch, resolution):
         _new_child(root, obj, part, patch, 0)
         write_surface(obj, surface, resolution)
     except BaseException:
-        _remove_object(obj)
+        remove_object(obj)
         raise
     return obj
 
@@ -549,7 +542,7 @@ def show_result(root, result: DisplayResult) -> dict:
     surplus = sorted((key for key in parts if key[0] == "blade" and (key[1] >= len(surfaces) or key[2] >= Z)),
                      key=lambda key: -key[2])
     for key in surplus:
-        _remove_object(parts.pop(key))
+        remove_object(parts.pop(key))
     hub = parts.get(("hub", 0, 0))
     if hub is None:
         parts[("hub", 0, 0)] = _new_surface_child(root, result.hub, f"{base} hub", "hub", 0, HUB_RESOLUTION)
@@ -590,7 +583,7 @@ def _show_overlay(root, parts: dict, smoothed) -> None:
     objects drawn in front and never rendered or exported."""
     wanted = {} if smoothed is None else overlay_polylines(smoothed)
     for key in [k for k in parts if k[0] == "overlay" and k[1] not in wanted]:
-        _remove_object(parts.pop(key))
+        remove_object(parts.pop(key))
     for index, (label, polylines) in wanted.items():
         obj = parts.get(("overlay", index, 0))
         if obj is None:
@@ -697,7 +690,7 @@ def create_propeller(context, result: DisplayResult, smoothing: dict, display_to
     except BaseException:
         created.extend(child for child in root.children if child not in created)
         for obj in reversed(created):
-            _remove_object(obj)
+            remove_object(obj)
         raise
     return root
 

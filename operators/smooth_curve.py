@@ -37,7 +37,7 @@ from ..geometry.fairing import (
 from ..geometry.fairing.curvature import span_samples
 from ..geometry.nurbs import BSplineCurve
 from .import_airfoil import stored_airfoil
-from .nurbs_objects import curve_to_object, object_to_geometry, stored_geometry
+from .nurbs_objects import curve_to_object, object_to_geometry, remove_object, stored_geometry
 
 #: Points farther than this fraction of the curve's size from its best-fit plane make
 #: the curve non-planar (float32 coordinates leave ~1e-7 of noise).
@@ -164,10 +164,7 @@ def build_objects(source_obj, result, origin, axes, plot_height: float, comb_len
         }
     except BaseException:
         for obj in made:
-            data = obj.data
-            bpy.data.objects.remove(obj)
-            if data is not None and data.users == 0:
-                bpy.data.curves.remove(data)
+            remove_object(obj)
         bpy.data.collections.remove(collection)
         raise
     return made

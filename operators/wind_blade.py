@@ -56,7 +56,7 @@ from ..geometry.propeller import dumps_toml
 from ..iges import surface_from_geometry, write_iges
 from . import nurbs_objects
 from .progress import progress_callback
-from .nurbs_objects import write_curve, write_surface
+from .nurbs_objects import remove_object, write_curve, write_surface
 
 #: Custom property naming a child's part (a key of BladeMolds.surfaces / parting_lines, or "single").
 PART_KEY = "bladesmith_mold_part"
@@ -205,13 +205,6 @@ def part_label(name: str) -> str:
     return name.replace("_", " ")
 
 
-def _remove_object(obj) -> None:
-    data = obj.data
-    bpy.data.objects.remove(obj, do_unlink=True)
-    if data is not None and data.users == 0:
-        bpy.data.curves.remove(data)
-
-
 def _new_child(root, entity, name: str, part: str):
     collections = list(root.users_collection) or [bpy.context.scene.collection]
     if isinstance(entity, BSplineCurve):
@@ -224,7 +217,7 @@ def _new_child(root, entity, name: str, part: str):
         obj.parent = root
         obj[PART_KEY] = part
     except BaseException:
-        _remove_object(obj)
+        remove_object(obj)
         raise
     return obj
 
@@ -235,12 +228,12 @@ def show_molds(root, molds: BladeMolds, mold_halves: bool) -> dict:
     parts = mold_parts(root)
     wanted = displayed_entities(molds, mold_halves)
     for name in [n for n in parts if n not in wanted]:
-        _remove_object(parts.pop(name))
+        remove_object(parts.pop(name))
     for name, entity in wanted.items():
         obj = parts.get(name)
         is_curve = isinstance(entity, BSplineCurve)
         if obj is not None and obj.type != ("CURVE" if is_curve else "SURFACE"):
-            _remove_object(parts.pop(name))
+            remove_object(parts.pop(name))
             obj = None
         if obj is None:
             parts[name] = _new_child(root, entity, f"{root.name} {part_label(name)}", name)
@@ -349,7 +342,7 @@ def create_wind_blade(context, molds: BladeMolds, mold_halves: bool, seconds: fl
         context.view_layer.objects.active = root
     except BaseException:
         for child in list(root.children):
-            _remove_object(child)
+            remove_object(child)
         bpy.data.objects.remove(root, do_unlink=True)
         raise
     return root
