@@ -87,3 +87,35 @@ def test_elliptic_cylinder_mvs():
 def test_refuses_non_surfaces():
     with pytest.raises(GeometryError):
         surface_fairness("not a surface")
+
+
+def test_curve_fairness_matches_its_surface_and_closed_forms():
+    """The curve forms of Eq. 6 on the rational quarter ellipse: H × the curve's values
+    equal the extruded surface's MVS and strain energy, and both match quadrature of
+    the closed forms; a 3-D copy of the curve gives the same numbers."""
+    from bladesmith.geometry.fairing.surface_fairness import curve_fairness
+    from bladesmith.geometry.nurbs import BSplineCurve
+
+    a, b, H = 2.0, 1.0, 0.5
+    P = np.array([[a, 0.0], [a, b], [0.0, b]])
+    w = np.array([1.0, np.sqrt(0.5), 1.0])
+    c2 = BSplineCurve(degree=2, knots=QUAD_KNOTS, control_points=P, weights=w)
+    f = curve_fairness(c2, 40)
+    s = surface_fairness(extruded(P, w, H), 40)
+    assert H * f.curvature_variation == pytest.approx(s.mvs, rel=1e-10)
+    assert H * f.bending_energy == pytest.approx(s.strain_energy, rel=1e-10)
+    assert f.length * H == pytest.approx(s.area, rel=1e-12)
+    c3 = BSplineCurve(degree=2, knots=QUAD_KNOTS, control_points=np.column_stack([P, np.zeros(3)]), weights=w)
+    g = curve_fairness(c3, 40)
+    assert g.curvature_variation == pytest.approx(f.curvature_variation, rel=1e-12)
+    # circle: κ = 1/R, dκ/ds = 0
+    R = 3.0
+    Pc, wc = arc(0.0, np.pi / 2, R)
+    c = curve_fairness(BSplineCurve(degree=2, knots=QUAD_KNOTS, control_points=Pc, weights=wc), 10)
+    assert c.bending_energy == pytest.approx(np.pi / 2 * R / R**2, rel=1e-12)
+    assert c.curvature_variation < 1e-20
+    # a straight segment: both zero, no division by zero
+    line = curve_fairness(BSplineCurve(degree=1, knots=LIN_KNOTS, control_points=np.array([[0.0, 0.0], [1.0, 2.0]])))
+    assert line.bending_energy == 0.0 and line.curvature_variation == 0.0
+    with pytest.raises(GeometryError):
+        curve_fairness("not a curve")
