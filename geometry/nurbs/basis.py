@@ -6,6 +6,8 @@ and works on all of them at once; loops run only over the degree.
 """
 from __future__ import annotations
 
+from math import factorial
+
 import numpy as np
 
 from ..errors import GeometryError
@@ -197,3 +199,35 @@ def basis_function_derivatives(
         ders[..., k, :] *= factor
         factor *= p - k
     return ders
+
+
+def taylor_matrices(knots: np.ndarray, degree: int, n_control: int):
+    """Per knot span i (p <= i <= n): the span midpoint m_i and the matrix T_i with
+    ``T_i[k, c] = N^(k)_{i-p+c}(m_i) / k!``, so that on span i
+    ``sum_c N_{i-p+c}(u) P_c = sum_k (u - m_i)^k (T_i P)_k`` (Taylor expansion of the
+    basis, exact for polynomials of degree p; derivatives from NURBS Book Alg. A2.3).
+    Empty spans get zero matrices; they are never selected by :func:`find_span`."""
+    spans = np.arange(degree, n_control)
+    lo, hi = knots[spans], knots[spans + 1]
+    mid = 0.5 * (lo + hi)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        T = basis_function_derivatives(knots, degree, mid, spans, degree)
+    T /= np.array([factorial(k) for k in range(degree + 1)])[:, None]
+    T[hi <= lo] = 0.0
+    return mid, T
+
+
+def monomial_derivatives(t: np.ndarray, degree: int, order: int) -> np.ndarray:
+    """``out[k, n, a] = d^k/dt^k t^a`` at t[n], for k <= order: shape (order+1, N, degree+1)."""
+    powers = np.empty((t.size, degree + 1))
+    powers[:, 0] = 1.0
+    for a in range(1, degree + 1):
+        np.multiply(powers[:, a - 1], t, out=powers[:, a])
+    if order == 0:
+        return powers[None]
+    out = np.zeros((order + 1, t.size, degree + 1))
+    out[0] = powers
+    for k in range(1, order + 1):
+        for a in range(k, degree + 1):
+            out[k, :, a] = (factorial(a) // factorial(a - k)) * powers[:, a - k]
+    return out

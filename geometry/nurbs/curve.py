@@ -3,10 +3,16 @@
 Evaluation and derivatives follow Piegl & Tiller, The NURBS Book 2e: Alg. A3.1/A3.2
 (non-rational point and derivatives), A4.1/A4.2 (rational point and derivatives from
 the homogeneous ones). Everything is float64 and vectorised over parameters.
+
+As for surfaces (see ``surface.py``), many points per knot span (projection, dense
+sampling) go through a cached table of each span's Taylor coefficients about its
+midpoint, one gather and a small contraction per point; few points use the basis
+functions of A2.2/A2.3 directly. Both give the same numbers to round-off.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from math import comb
 
 import numpy as np
@@ -18,9 +24,15 @@ from .basis import (
     check_parameters,
     domain_of,
     find_span,
+    monomial_derivatives,
+    taylor_matrices,
     validate_degree,
     validate_knots,
 )
+
+
+#: The span table is used when there are at least this many points per knot span.
+TABLE_MIN_POINTS_PER_SPAN = 4
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -142,8 +154,27 @@ class BSplineCurve:
         return float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
 
     # -- evaluation ---------------------------------------------------------------
+    @cached_property
+    def _span_table(self):
+        """(span midpoints, Taylor coefficients (n_spans, p+1, dim')) of the homogeneous
+        curve: on span i, Cw(u) = sum_a (u - m_i)^a table[i, a]."""
+        p = self.degree
+        Pw = self.homogeneous if self.is_rational else self.control_points
+        mid, T = taylor_matrices(self.knots, p, self.n_control)
+        windows = np.lib.stride_tricks.sliding_window_view(Pw, p + 1, axis=0)  # (spans, dim', p+1)
+        table = np.einsum("iac,idc->iad", T, windows)
+        table.flags.writeable = False
+        return mid, table
+
     def _homogeneous_derivatives(self, u: np.ndarray, order: int) -> np.ndarray:
         p = self.degree
+        if u.size >= TABLE_MIN_POINTS_PER_SPAN * (self.n_control - p):
+            mid, table = self._span_table
+            flat = u.ravel()
+            i = find_span(self.knots, p, flat) - p
+            M = monomial_derivatives(flat - mid[i], p, order)  # (order+1, N, p+1)
+            out = np.matmul(M.transpose(1, 0, 2), table[i])
+            return out.reshape(u.shape + out.shape[1:])
         span = find_span(self.knots, p, u)
         Pw = self.homogeneous if self.is_rational else self.control_points
         idx = span[..., None] - p + np.arange(p + 1)

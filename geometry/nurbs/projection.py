@@ -15,6 +15,8 @@ search continues along the boundary.
 """
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from ..errors import GeometryError
@@ -60,6 +62,11 @@ SURFACE_GRID_MAX = 1 << 18
 
 #: Query points times coarse samples handled per block when ranking the samples.
 BLOCK_ENTRIES = 1 << 22
+
+#: Above this many (point, sample) pairs the curve brackets are built from the samples
+#: near each point only (a k-d tree query), not from the dense point × sample table.
+SPARSE_BRACKET_PAIRS = 1 << 17
+
 
 #: Newton iterations before giving up improving (the best point so far is returned).
 MAX_ITERATIONS = 100
@@ -196,6 +203,8 @@ def _curve_brackets(P, ts, C0, C1, k):
     samples on a fast-moving stretch of the curve is still found.
     """
     M = ts.size
+    if P.shape[0] * M > SPARSE_BRACKET_PAIRS and M > 2:
+        return _curve_brackets_near(P, ts, C0, C1, k)
     cc = np.einsum("sd,sd->s", C1, C0)
     g2 = np.einsum("sd,sd->s", C0, C0)
     lo = np.empty((P.shape[0], k))
@@ -231,6 +240,63 @@ def _curve_brackets(P, ts, C0, C1, k):
         lo[s : s + block] = np.where(found, a, fb_lo[:, None])
         hi[s : s + block] = np.where(found, b, fb_hi[:, None])
         start[s : s + block] = np.where(found, st, ts[j][:, None])
+    return lo, hi, start
+
+
+def _curve_brackets_near(P, ts, C0, C1, k):
+    """:func:`_curve_brackets` restricted to the sample intervals near each point, with the
+    same result: the interval holding the closest point C(u*) has its nearer end within
+    d* + (its arc) <= d0 + 2 h of P, where d0 is the distance to the nearest sample and h
+    the longest sample chord (the samples turn by at most :data:`CURVE_SAMPLE_TURN`, so
+    an interval's arc is within 1 % of its chord); every interval ranked above it is
+    nearer still. So the k best brackets are among the intervals with an end in the ball
+    of radius d0 + 2 h, found with a k-d tree (``scipy.spatial.cKDTree``)."""
+    from scipy.spatial import cKDTree
+
+    M, nP = ts.size, P.shape[0]
+    tree = cKDTree(C0)
+    d0, j = tree.query(P)
+    h = float(np.max(np.linalg.norm(np.diff(C0, axis=0), axis=1)))
+    balls = tree.query_ball_point(P, d0 + 2.0 * h, return_sorted=False)
+    lens = np.fromiter(map(len, balls), dtype=np.int64, count=nP)
+    pid = np.repeat(np.arange(nP), lens)
+    sid = np.fromiter(itertools.chain.from_iterable(balls), dtype=np.int64, count=int(lens.sum()))
+    # intervals touching a sample in the ball (interval i joins samples i and i + 1)
+    iv = np.concatenate([sid - 1, sid])
+    pv = np.concatenate([pid, pid])
+    keep = (iv >= 0) & (iv <= M - 2)
+    key = np.unique(pv[keep] * M + iv[keep])
+    pv, iv = key // M, key % M
+    cc = np.einsum("sd,sd->s", C1, C0)
+    g2 = np.einsum("sd,sd->s", C0, C0)
+    Pp = P[pv]
+    Fl = cc[iv] - np.einsum("sd,sd->s", Pp, C1[iv])
+    Fr = cc[iv + 1] - np.einsum("sd,sd->s", Pp, C1[iv + 1])
+    Ql = g2[iv] - 2.0 * np.einsum("sd,sd->s", Pp, C0[iv])
+    Qr = g2[iv + 1] - 2.0 * np.einsum("sd,sd->s", Pp, C0[iv + 1])
+    interior = (Fl < 0) & (Fr >= 0)
+    # domain ends (dense: two samples per point)
+    F0 = cc[0] - P @ C1[0]
+    Fe = cc[-1] - P @ C1[-1]
+    Q0 = g2[0] - 2.0 * P @ C0[0]
+    Qe = g2[-1] - 2.0 * P @ C0[-1]
+    ar = np.arange(nP)
+    cand_p = np.concatenate([pv[interior], ar, ar])
+    cand_s = np.concatenate([np.minimum(Ql, Qr)[interior], np.where(F0 >= 0, Q0, np.inf), np.where(Fe <= 0, Qe, np.inf)])
+    cand_a = np.concatenate([ts[iv][interior], np.full(nP, ts[0]), np.full(nP, ts[-1])])
+    cand_b = np.concatenate([ts[iv + 1][interior], np.full(nP, ts[0]), np.full(nP, ts[-1])])
+    cand_st = np.concatenate([np.where(Ql <= Qr, ts[iv], ts[iv + 1])[interior], np.full(nP, ts[0]), np.full(nP, ts[-1])])
+    order = np.lexsort((cand_s, cand_p))
+    cand_p, cand_s, cand_a, cand_b, cand_st = (x[order] for x in (cand_p, cand_s, cand_a, cand_b, cand_st))
+    first = np.searchsorted(cand_p, ar)
+    count = np.diff(np.r_[first, cand_p.size])  # >= 2 (the two ends)
+    rank = np.minimum(np.arange(k)[None, :], count[:, None] - 1)  # pad with the best one
+    idx = first[:, None] + rank
+    found = np.isfinite(cand_s[idx])
+    fb_lo, fb_hi = ts[np.maximum(j - 1, 0)], ts[np.minimum(j + 1, M - 1)]
+    lo = np.where(found, cand_a[idx], fb_lo[:, None])
+    hi = np.where(found, cand_b[idx], fb_hi[:, None])
+    start = np.where(found, cand_st[idx], ts[j][:, None])
     return lo, hi, start
 
 

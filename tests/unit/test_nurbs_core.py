@@ -249,3 +249,22 @@ def test_parameters_outside_the_domain_are_refused():
         curve.evaluate([np.nan])
     # round-off just past the end is taken as the end
     assert np.allclose(curve.evaluate(1 + 1e-13), GOOD_POINTS[-1])
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_curve_span_table_and_basis_paths_agree(rational):
+    """Many parameters go through the cached Taylor table of the spans, few through the
+    basis functions (NURBS Book A2.3); both give the same values and derivatives."""
+    from bladesmith.geometry.nurbs import curve as curve_module
+
+    rng = np.random.default_rng(11 + rational)
+    for degree in (1, 2, 3, 5):
+        n = degree + 8
+        knots = np.concatenate([np.zeros(degree + 1), np.sort(rng.uniform(0, 2, n - degree - 1)), np.full(degree + 1, 2.0)])
+        c = BSplineCurve(degree, knots, rng.normal(size=(n, 3)) * 10, rng.uniform(0.5, 2.0, n) if rational else None)
+        u = np.concatenate([rng.uniform(0, 2, 400), knots[degree:-degree]])
+        assert u.size >= curve_module.TABLE_MIN_POINTS_PER_SPAN * (n - degree)
+        many = c.derivatives(u, 3)
+        few = np.stack([c.derivatives(u[i: i + 1], 3)[0] for i in range(u.size)])
+        scale = np.abs(few).max(axis=0, keepdims=True) + 1.0
+        assert np.max(np.abs(many - few) / scale) < 1e-13, degree

@@ -138,3 +138,26 @@ def test_points_on_strongly_rational_surfaces_project_onto_them():
         _, _, dist = closest_point_surface(surface, surface.evaluate(uv[:, 0], uv[:, 1]))
         worst = max(worst, dist.max() / surface.size())
     assert worst < 1e-9, worst
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_curve_brackets_near_each_point_agree_with_the_dense_table(rational, monkeypatch):
+    """Many points (the k-d tree path of ``_curve_brackets``) and few (the dense point ×
+    sample table) give the same closest points, including points far from the curve,
+    points on it and points near self-approaching stretches."""
+    from bladesmith.geometry.nurbs import projection
+
+    rng = np.random.default_rng(7 + rational)
+    n = 30
+    P = np.cumsum(rng.normal(size=(n, 3)), axis=0)
+    P[n // 2:] = P[n // 2 - 1::-1][: n - n // 2] + 0.05 * rng.normal(size=(n - n // 2, 3))  # doubles back
+    curve = BSplineCurve(3, _strongly_rational_knots(rng, n, 3), P, rng.uniform(0.3, 3.0, n) if rational else None)
+    lo, hi = P.min(axis=0) - 2, P.max(axis=0) + 2
+    Q = np.concatenate([rng.uniform(lo, hi, (1500, 3)), curve.evaluate(rng.uniform(0, 1, 500))])
+    t_near, d_near = closest_point_curve(curve, Q)
+    monkeypatch.setattr(projection, "SPARSE_BRACKET_PAIRS", 1 << 62)
+    t_dense, d_dense = closest_point_curve(curve, Q)
+    assert np.max(np.abs(d_near - d_dense)) <= 1e-13 * curve.size()
+    # same distance; the parameter may differ only where two feet are equally near
+    differ = np.abs(t_near - t_dense) > 1e-9
+    assert differ.sum() <= 2
