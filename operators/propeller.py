@@ -288,6 +288,9 @@ def settings_to_dict(settings) -> dict:
     else:
         thickness = THICKNESS_FORMS[kind]
     section = {"thickness": thickness, "meanline": MEANLINES[settings.meanline]}
+    if kind == THICKNESS_FILE and settings.smooth_airfoil:  # only an airfoil file is smoothed
+        section["smooth_airfoil"] = True
+        section["smooth_passes"] = int(settings.smooth_passes)
     if kind == "TABLE":
         section["thickness_x_c"] = [_decimal(row.x_c) for row in settings.thickness_table]
         section["thickness_t"] = [_decimal(row.value) for row in settings.thickness_table]
@@ -346,6 +349,8 @@ def definition_to_settings(settings, propeller: Propeller, smoothing: dict | Non
             settings.thickness_kind = THICKNESS_FILE
             settings.thickness_file = str(path.resolve())
         settings.meanline = {v: k for k, v in MEANLINES.items()}[sec.meanline]
+        settings.smooth_airfoil = sec.smooth_airfoil
+        settings.smooth_passes = sec.smooth_passes
         for table, xs, ys in (
             (settings.thickness_table, sec.thickness_x_c, sec.thickness_t),
             (settings.meanline_table, sec.meanline_x_c, sec.meanline_f),
@@ -403,7 +408,7 @@ SECTION_CACHE_SIZE = 4
 def _section_key(propeller: Propeller):
     sec = propeller.section
     key = (sec.thickness, sec.meanline, sec.thickness_x_c, sec.thickness_t, sec.meanline_x_c, sec.meanline_f,
-           str(propeller.base_dir))
+           sec.smooth_airfoil, sec.smooth_passes, str(propeller.base_dir))
     path = pathlib.Path(sec.thickness)
     if propeller.base_dir is not None and not path.is_absolute():
         path = propeller.base_dir / path
@@ -607,6 +612,9 @@ def store_status(settings, result: DisplayResult, seconds: float) -> None:
     else:
         settings.display_deviation = -1.0
         detail = smoothing_summary(result.smoothing)
+    deviation = getattr(result.model.blade.section, "smoothing_deviation", None)
+    if deviation is not None:
+        detail += f"; airfoil smoothed (Hvid), deviation {deviation:.2e} chord"
     settings.status = f"{detail}; {seconds * 1e3:.0f} ms"
     settings.status_is_error = False
     settings.regeneration_time = seconds

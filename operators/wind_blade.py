@@ -148,6 +148,8 @@ def settings_to_dict(settings) -> dict:
         "first_aerodynamic_station": int(settings.first_aerodynamic_station),
         "control_points": int(settings.control_points),
         "tolerance": _typed(settings.tolerance),
+        "smooth_airfoils": bool(settings.smooth_airfoils),
+        "smooth_passes": int(settings.smooth_passes),
         "stations": {
             **{name: [_typed(getattr(row, name)) for row in rows] for name in STATION_FIELDS},
             "airfoil": [row.airfoil.strip() for row in rows],
@@ -172,6 +174,8 @@ def definition_to_settings(settings, defn: BladeDefinition, base_dir: str = "") 
         settings.first_aerodynamic_station = defn.first_aerodynamic_station
         settings.control_points = defn.control_points
         settings.tolerance = defn.tolerance
+        settings.smooth_airfoils = defn.smooth_airfoils
+        settings.smooth_passes = defn.smooth_passes
         settings.base_dir = base_dir
         settings.source_path = defn.path
         settings.stations.clear()
@@ -268,8 +272,10 @@ def store_results(settings, molds: BladeMolds, seconds: float) -> None:
             settings.strain_energy_two_part = fair["two_part"]["strain_energy"]
             settings.strain_energy_single = fair["single"]["strain_energy"]
         settings.regeneration_time = seconds
+        smoothed = [st.airfoil.smoothing_deviation for st in defn.stations if st.airfoil.smoothing_deviation is not None]
+        note = f"; airfoils smoothed (Hvid), worst deviation {max(smoothed):.2e} chord" if smoothed else ""
         settings.status = (f"{molds.control_points} control points per half, worst section "
-                           f"{settings.max_deviation:.2e} chord; {seconds * 1e3:.0f} ms")
+                           f"{settings.max_deviation:.2e} chord{note}; {seconds * 1e3:.0f} ms")
         settings.status_is_error = False
 
 

@@ -90,6 +90,16 @@ def _setting_annotations() -> dict:
         "thickness_file": StringProperty(name="Airfoil File", description="Airfoil .dat file of the thickness form",
                                          subtype="FILE_PATH", update=_edited),
         "meanline": EnumProperty(name="Mean Line", items=_MEANLINE_ITEMS, default="A08", update=_edited),
+        "smooth_airfoil": BoolProperty(
+            name="Smooth airfoil (Hvid)", description="Smooth the airfoil file's outline before taking its "
+            "thickness and mean line: curvature-based smoothing of Hvid (1993) smoothfoil with its default "
+            "settings (airfoil files only)", default=False, update=_edited,
+        ),
+        "smooth_passes": IntProperty(
+            name="Smoothing Passes", description="Passes of Hvid's ad hoc curvature smoother (the paper uses 4); "
+            "fewer keep the section closer to the file, the status line gives the deviation",
+            default=4, min=1, max=50, update=_edited,
+        ),
         "thickness_table": CollectionProperty(type=BLADESMITH_PG_table_point),
         "thickness_index": IntProperty(default=0, options={"HIDDEN"}),
         "meanline_table": CollectionProperty(type=BLADESMITH_PG_table_point),
@@ -228,6 +238,12 @@ class BLADESMITH_PT_propeller_section(_Sub, bpy.types.Panel):
         col.prop(s, "thickness_kind")
         if s.thickness_kind == ops.THICKNESS_FILE:
             col.prop(s, "thickness_file")
+        row = col.row()
+        row.enabled = s.thickness_kind == ops.THICKNESS_FILE  # only an airfoil file is smoothed
+        row.prop(s, "smooth_airfoil")
+        row = col.row()
+        row.enabled = s.thickness_kind == ops.THICKNESS_FILE and s.smooth_airfoil
+        row.prop(s, "smooth_passes")
         col.prop(s, "meanline")
         for kind, label, collection, index in (
             (s.thickness_kind == "TABLE", "Thickness table (x/c, T/T0)", "thickness_table", "thickness_index"),

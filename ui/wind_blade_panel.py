@@ -78,6 +78,16 @@ def _annotations() -> dict:
         "wrap": BoolProperty(name="Wrap Sections", description="Wrap the aerodynamic sections onto their "
                              "cylinders of radius r (Hosseini Eq. 5); off: flat sections", default=True,
                              update=_edited),
+        "smooth_airfoils": BoolProperty(
+            name="Smooth airfoils (Hvid)", description="Smooth the airfoils of the aerodynamic stations first: "
+            "curvature-based smoothing of Hvid (1993) smoothfoil with its default settings (\"circle\" and the "
+            "root-transition stations are kept as they are)", default=False, update=_edited,
+        ),
+        "smooth_passes": IntProperty(
+            name="Smoothing Passes", description="Passes of Hvid's ad hoc curvature smoother (the paper uses 4); "
+            "fewer keep the sections closer to the files, the status line gives the deviation",
+            default=4, min=1, max=50, update=_edited,
+        ),
         "first_aerodynamic_station": IntProperty(
             name="First Airfoil Station", description="Index of the first aerodynamic station; the stations "
             "before it form the root transition (Hosseini §5.1)", default=0, soft_min=0, update=_edited,
@@ -184,9 +194,11 @@ class BLADESMITH_PT_wind_blade(_WindBladePanel, bpy.types.Panel):
             box.label(text=line, icon="ERROR" if s.status_is_error else "NONE")
         col = layout.column()
         col.use_property_split = True
-        for name in ("definition_name", "hub_radius", "mold_direction", "wrap", "first_aerodynamic_station",
-                     "control_points", "tolerance", "mold_halves", "base_dir"):
-            col.prop(s, name)
+        for name in ("definition_name", "hub_radius", "mold_direction", "wrap", "smooth_airfoils", "smooth_passes",
+                     "first_aerodynamic_station", "control_points", "tolerance", "mold_halves", "base_dir"):
+            row = col.row()
+            row.enabled = name != "smooth_passes" or s.smooth_airfoils
+            row.prop(s, name)
 
 
 class _Sub(_WindBladePanel):

@@ -81,6 +81,19 @@ SHARP_TE_TOL = 1e-9
 #: The leading edge must lie inside the outline by this many points from either end.
 MIN_POINTS_PER_SIDE = 3
 
+#: Extension length L of a blunt trailing edge: TE_EXTENSION_GAPS × the trailing-edge gap,
+#: clipped to [MIN_TE_EXTENSION, MAX_TE_FALLBACK] chord. The ends are extended to where
+#: their tangents meet (Hvid 1993 §3.3 step 1) when that is within TE_MEET_FACTOR × L;
+#: otherwise (tangents parallel, diverging, or meeting far behind, e.g. DU 30 at 0.37 c,
+#: whose long straight extension would take a third of the smoothing points) by L and
+#: bent gently onto a common apex.
+TE_EXTENSION_GAPS = 10.0
+TE_MEET_FACTOR = 2.0
+MIN_TE_EXTENSION = 0.02
+MAX_TE_FALLBACK = 0.2
+#: |det| of the two unit end tangents below which they count as parallel.
+PARALLEL_TANGENT_TOL = 1e-12
+
 #: Samples per knot span when measuring the true deviation between curves and extremes
 #: of curvature.
 DEVIATION_SAMPLES_PER_SPAN = 6
@@ -888,8 +901,10 @@ def _chord_frame(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, np.
 
 def _extend_trailing_edge(points: np.ndarray, order: int) -> tuple[np.ndarray, int, int]:
     """Hvid (1993) §3.3 "Airfoil preparation" step 1: extend both trailing-edge ends
-    along their end tangents to the point where the tangents meet. Returns the new outline
-    (apex first and last) and the number of points added at each end."""
+    along their end tangents to the point where the tangents meet (when that is behind
+    the trailing edge and within :data:`TE_MEET_FACTOR` × L; otherwise along the
+    tangents and gently onto a common apex, see below). Returns the new outline (apex
+    first and last) and the number of points added at each end."""
     spline, _ = spline_through(points, order)
     t0 = -spline.derivatives(spline.domain[0], 1)[1]
     t1 = spline.derivatives(spline.domain[1], 1)[1]
@@ -897,23 +912,35 @@ def _extend_trailing_edge(points: np.ndarray, order: int) -> tuple[np.ndarray, i
     p0, p1 = points[0], points[-1]
     A = np.stack([t0, -t1], axis=1)
     det = np.linalg.det(A)
-    if abs(det) < 1e-12:
-        raise GeometryError("smoothfoil: the trailing-edge tangents are parallel; a blunt trailing edge cannot be extended")
-    a, b = np.linalg.solve(A, p1 - p0)
     gap = float(np.linalg.norm(p1 - p0))
-    if a <= 0 or b <= 0 or max(a, b) > 1.0:
-        raise GeometryError(
-            f"smoothfoil: the trailing-edge tangents do not meet behind the trailing edge (extensions {a:.3g}, {b:.3g} "
-            f"chord for a gap of {gap:.3g}); cannot extend the blunt trailing edge (Hvid 1993 §3.3)"
-        )
-    apex = p0 + a * t0
+    a = b = np.inf
+    if abs(det) > PARALLEL_TANGENT_TOL:
+        a, b = np.linalg.solve(A, p1 - p0)
     h0 = float(np.linalg.norm(points[1] - points[0]))
     h1 = float(np.linalg.norm(points[-1] - points[-2]))
-    k0 = max(2, int(np.ceil(a / h0)))
-    k1 = max(2, int(np.ceil(b / h1)))
-    head = apex + (p0 - apex) * (np.arange(k0) / k0)[:, None]
-    tail = p1 + (apex - p1) * (np.arange(1, k1 + 1) / k1)[:, None]
-    return np.concatenate([head, points, tail]), k0, k1
+    L = float(np.clip(TE_EXTENSION_GAPS * gap, MIN_TE_EXTENSION, MAX_TE_FALLBACK))
+    if 0 < a <= TE_MEET_FACTOR * L and 0 < b <= TE_MEET_FACTOR * L:
+        apex = p0 + a * t0
+        k0 = max(2, int(np.ceil(a / h0)))
+        k1 = max(2, int(np.ceil(b / h1)))
+        head = apex + (p0 - apex) * (np.arange(k0) / k0)[:, None]
+        tail = p1 + (apex - p1) * (np.arange(1, k1 + 1) / k1)[:, None]
+        return np.concatenate([head, points, tail]), k0, k1
+    # The tangents are (nearly) parallel or diverge (thick blunt sections such as DU 35):
+    # extend each end along its tangent by L and bend it gently onto the common apex
+    # m, the mid-point of the two straight extensions: x(s) = p + s t + (s/L)^2 (m - p - L t),
+    # s in [0, L], which leaves p with the end tangent t (so the kept part of the outline is
+    # not kinked) and with curvature about gap / L^2.
+    m = 0.5 * ((p0 + L * t0) + (p1 + L * t1))
+    k0 = max(2, int(np.ceil(L / h0)))
+    k1 = max(2, int(np.ceil(L / h1)))
+
+    def branch(p, t, k, reverse):
+        s = L * (np.arange(1, k + 1) / k)
+        pts = p + s[:, None] * t + (s / L)[:, None] ** 2 * (m - p - L * t)
+        return pts[::-1] if reverse else pts
+
+    return np.concatenate([branch(p0, t0, k0, True), points, branch(p1, t1, k1, False)]), k0, k1
 
 
 def smoothfoil(
@@ -1025,12 +1052,18 @@ def smoothfoil(
     )
 
 
-def smooth_airfoil_points(points, count: int | None = None, **options) -> np.ndarray:
-    """Optional pre-processing hook for section pipelines (propeller, wind blade): the
-    outline (m, 2) TE → LE → TE smoothed by :func:`smoothfoil` and resampled at ``count``
-    points (default m) in the input's frame and direction. ``options``: ``distribution``
-    and any :class:`SmoothingSettings` field. Raises :class:`SmoothingNotConverged`."""
+def smooth_airfoil_result(points, count: int | None = None, **options) -> SmoothingResult:
+    """The section pipelines' pre-processing (propeller, wind blade): the outline (m, 2)
+    TE → LE → TE smoothed by :func:`smoothfoil`, with its report; ``result.points`` are
+    resampled at ``count`` points (default m) in the input's frame and direction.
+    ``options``: ``distribution`` and any :class:`SmoothingSettings` field (default: the
+    paper's jobcard). Raises :class:`SmoothingNotConverged`."""
     P = _as_points(points, "airfoil outline")
     distribution = options.pop("distribution", None)
     settings = SmoothingSettings(**{"output_points": int(count or P.shape[0]), **options})
-    return smoothfoil(P, distribution, settings).points
+    return smoothfoil(P, distribution, settings)
+
+
+def smooth_airfoil_points(points, count: int | None = None, **options) -> np.ndarray:
+    """:func:`smooth_airfoil_result`'s points only."""
+    return smooth_airfoil_result(points, count, **options).points

@@ -9,6 +9,9 @@ Format (every array of ``[stations]`` has one value per station, root to tip)::
     first_aerodynamic_station = 4      # optional; stations before it form the root transition (§5.1)
     control_points = 14                # optional; per half and section, raised until the tolerance holds
     tolerance = 1e-4                   # optional; fraction of the local chord
+    smooth_airfoils = false            # optional; smooth the aerodynamic stations' airfoils first
+                                       # (Hvid 1993 smoothfoil, default jobcard)
+    smooth_passes = 4                  # optional; passes of its ad hoc curvature smoother (1-50)
 
     [stations]
     r = [...]           # m, strictly increasing
@@ -20,18 +23,25 @@ Format (every array of ``[stations]`` has one value per station, root to tip)::
     airfoil = [...]     # a .dat path (relative to the TOML file) or a shipped name, or "circle"
 
 Errors are :class:`DefinitionError` naming the file, the field and the station.
+
+``smooth_airfoils``: every airfoil of an aerodynamic station (from
+``first_aerodynamic_station`` on; "circle" excepted) is replaced by its outline smoothed
+with Hvid's smoothfoil (Hvid 1993, DTU AFM 93-08; default jobcard), each file once per
+load (and once per process while it is unchanged). The structural-zone stations keep
+their sections: they are the root circle the flange is machined to.
 """
 from __future__ import annotations
 
 import math
 import pathlib
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..errors import BladesmithError, DefinitionError
-from ..sections.airfoil_file import Airfoil, read_airfoil
+from ..sections.airfoil_file import Airfoil, read_airfoil, smoothed_airfoil
+from ..sections.shape import DEFAULT_SMOOTH_PASSES, MAX_SMOOTH_PASSES
 
 #: Points per half of the built-in "circle" section (cosine spaced, dense at the ends).
 CIRCLE_POINTS = 101
@@ -44,6 +54,11 @@ DEFAULT_TOLERANCE = 1e-4
 
 DATA_DIR = pathlib.Path(__file__).resolve().parent.parent.parent / "data"
 BLADES_DIR = DATA_DIR / "blades"
+
+#: Smoothed airfoils kept between loads (live edits reload the definition): key
+#: (path, modification time, size) of the file.
+SMOOTHED_CACHE_SIZE = 16
+_SMOOTHED: dict = {}
 
 REQUIRED = ("r", "chord", "twist_deg", "pitch_axis", "airfoil")
 OPTIONAL = ("prebend", "sweep")
@@ -107,6 +122,10 @@ class BladeDefinition:
     control_points: int = DEFAULT_CONTROL_POINTS
     tolerance: float = DEFAULT_TOLERANCE
     path: str = ""
+    #: The aerodynamic stations' airfoils are smoothed (Hvid 1993 smoothfoil)...
+    smooth_airfoils: bool = False
+    #: ...with this many passes of the ad hoc curvature smoother (the paper's jobcard: 4).
+    smooth_passes: int = DEFAULT_SMOOTH_PASSES
 
     def to_dict(self) -> dict:
         """The definition as TOML-ready values (airfoils by name or path)."""
@@ -115,6 +134,7 @@ class BladeDefinition:
             "name": self.name, "hub_radius": self.hub_radius, "mold_direction": self.mold_direction.tolist(),
             "wrap": self.wrap, "first_aerodynamic_station": self.first_aerodynamic_station,
             "control_points": self.control_points, "tolerance": self.tolerance,
+            "smooth_airfoils": self.smooth_airfoils, "smooth_passes": self.smooth_passes,
             "stations": {
                 "r": [s.r for s in st], "chord": [s.chord for s in st], "twist_deg": [s.twist_deg for s in st],
                 "pitch_axis": [s.pitch_axis for s in st], "prebend": [s.prebend for s in st],
@@ -190,7 +210,56 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
     wrap = data.get("wrap", True)
     if not isinstance(wrap, bool):
         raise DefinitionError(f"expected true or false, got {wrap!r}", path=path, field="wrap")
-    return BladeDefinition(name, hub, tuple(stations), d / np.linalg.norm(d), wrap, first, n, tol, path)
+    smooth = data.get("smooth_airfoils", False)
+    if not isinstance(smooth, bool):
+        raise DefinitionError(f"expected true or false, got {smooth!r}", path=path, field="smooth_airfoils")
+    passes = data.get("smooth_passes", DEFAULT_SMOOTH_PASSES)
+    if isinstance(passes, bool) or not isinstance(passes, int) or not 1 <= passes <= MAX_SMOOTH_PASSES:
+        raise DefinitionError(f"expected a whole number of passes from 1 to {MAX_SMOOTH_PASSES}, got {passes!r}",
+                              path=path, field="smooth_passes")
+    if smooth:
+        stations = _smoothed_stations(stations, first, path, passes)
+    return BladeDefinition(name, hub, tuple(stations), d / np.linalg.norm(d), wrap, first, n, tol, path, smooth,
+                           passes)
+
+
+def _smoothed_airfoil(foil: Airfoil, passes: int) -> Airfoil:
+    """``foil`` smoothed by Hvid's smoothfoil, from the cache while its file is unchanged."""
+    try:
+        stat = pathlib.Path(foil.path).stat()
+        key = (str(pathlib.Path(foil.path).resolve()), stat.st_mtime_ns, stat.st_size, passes)
+    except OSError:
+        key = None
+    if key is not None and key in _SMOOTHED:
+        return _SMOOTHED[key]
+    out = smoothed_airfoil(foil, passes=passes)
+    if key is not None:
+        while len(_SMOOTHED) >= SMOOTHED_CACHE_SIZE:
+            _SMOOTHED.pop(next(iter(_SMOOTHED)))
+        _SMOOTHED[key] = out
+    return out
+
+
+def _smoothed_stations(stations: list, first: int, path, passes: int = DEFAULT_SMOOTH_PASSES) -> list:
+    """The stations with the airfoils of the aerodynamic ones (k >= ``first``, not
+    "circle") smoothed, each airfoil file once."""
+    done: dict = {}
+    out = []
+    for k, st in enumerate(stations):
+        if k < first or st.airfoil_name == "circle":
+            out.append(st)
+            continue
+        key = st.airfoil.path or st.airfoil_name
+        if key not in done:
+            try:
+                done[key] = _smoothed_airfoil(st.airfoil, passes)
+            except BladesmithError as exc:  # SmoothingNotConverged (a GeometryError) among them
+                raise DefinitionError(
+                    f"station {k}: the airfoil {st.airfoil_name!r} could not be smoothed (Hvid 1993 smoothfoil; "
+                    f"smooth_airfoils = false keeps it as read): {exc}",
+                    path=path, field=f"stations.airfoil[{k}]") from exc
+        out.append(replace(st, airfoil=done[key]))
+    return out
 
 
 def load_blade(path) -> BladeDefinition:

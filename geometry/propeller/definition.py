@@ -16,6 +16,9 @@ Format (every field is checked; messages name the file, the field and the value)
                                   # "airfoil" (the mean line of the .dat file)
     # thickness_x_c = [...]; thickness_t = [...]   (thickness = "table": x/c and T/T0)
     # meanline_x_c = [...];  meanline_f = [...]    (meanline = "table": x/c and f/f0)
+    # smooth_airfoil = true       # airfoil .dat thickness only, default false: smooth the file's
+                                  # outline first (Hvid 1993 smoothfoil, default jobcard)
+    # smooth_passes = 4           # passes of its ad hoc curvature smoother (1-50, default 4)
 
     [hub]                         # spine: nose, cylinder of the hub radius, tail (Hally §10)
     upstream_length = 0.1067      # m, from the propeller plane z = 0 to the nose tip (upstream)
@@ -51,6 +54,7 @@ import numpy as np
 
 from ..files import atomic_write
 from ..errors import DefinitionError
+from ..sections.shape import DEFAULT_SMOOTH_PASSES, MAX_SMOOTH_PASSES
 
 RADIAL_FIELDS = ("r_R", "c_D", "P_D", "skew_deg", "rake_D", "t_c", "f_c")
 CSV_ALIASES = {"t0_c": "t_c", "f0_c": "f_c"}
@@ -60,7 +64,10 @@ HUB_SHAPES = ("ellipse", "cone", "flat")
 TIP_TOL = 1e-9
 
 _TOP_KEYS = {"name", "blades", "diameter", "hub_diameter_ratio", "hand", "radial_table", "section", "hub", "radial"}
-_SECTION_KEYS = {"thickness", "meanline", "thickness_x_c", "thickness_t", "meanline_x_c", "meanline_f"}
+_SECTION_KEYS = {"thickness", "meanline", "thickness_x_c", "thickness_t", "meanline_x_c", "meanline_f", "smooth_airfoil",
+                 "smooth_passes"}
+#: Thickness names that are not airfoil files.
+_THICKNESS_FORMS = ("naca66mod", "naca4", "elliptic", "table")
 _HUB_KEYS = {"upstream_length", "downstream_length", "nose_shape", "nose_length", "tail_shape", "tail_length"}
 
 
@@ -119,6 +126,10 @@ class SectionDefinition:
     thickness_t: tuple | None = None
     meanline_x_c: tuple | None = None
     meanline_f: tuple | None = None
+    #: Smooth the airfoil file's outline first (Hvid 1993 smoothfoil); airfoil files only.
+    smooth_airfoil: bool = False
+    #: Passes of the ad hoc curvature smoother (Hvid §3.2; the paper's jobcard uses 4).
+    smooth_passes: int = 4
 
     def shape(self, base_dir=None, source=None):
         """The :class:`~bladesmith.geometry.sections.SectionShape` this names (errors name
@@ -132,6 +143,8 @@ class SectionDefinition:
             thickness_table=(self.thickness_x_c, self.thickness_t) if self.thickness_x_c is not None else None,
             meanline_table=(self.meanline_x_c, self.meanline_f) if self.meanline_x_c is not None else None,
             source=source,
+            smooth_airfoil=self.smooth_airfoil,
+            smooth_passes=self.smooth_passes,
         )
 
 
@@ -241,7 +254,21 @@ class Propeller:
             v = getattr(s, name)
             if v is not None:
                 object.__setattr__(s, name, _array(v, f"section.{name}", p))
-        if s.thickness not in ("naca66mod", "naca4", "elliptic", "table"):
+        if not isinstance(s.smooth_airfoil, bool):
+            raise DefinitionError(f"expected true or false, got {_fmt(s.smooth_airfoil)}", path=p,
+                                  field="section.smooth_airfoil")
+        if isinstance(s.smooth_passes, bool) or not isinstance(s.smooth_passes, int) \
+                or not 1 <= s.smooth_passes <= MAX_SMOOTH_PASSES:
+            raise DefinitionError(f"expected a whole number of passes from 1 to {MAX_SMOOTH_PASSES}, got "
+                                  f"{_fmt(s.smooth_passes)}", path=p, field="section.smooth_passes")
+        if s.smooth_airfoil and s.thickness in _THICKNESS_FORMS:
+            raise DefinitionError(
+                f"smooth_airfoil = true needs an airfoil .dat file as thickness (it smooths the file's outline, "
+                f"Hvid 1993), got thickness = {_fmt(s.thickness)}",
+                path=p,
+                field="section.smooth_airfoil",
+            )
+        if s.thickness not in _THICKNESS_FORMS:
             f = pathlib.Path(s.thickness)
             if self.base_dir is not None and not f.is_absolute():
                 f = self.base_dir / f
@@ -388,9 +415,12 @@ class Propeller:
     def to_dict(self, relative_to=None) -> dict:
         """Plain data (the TOML layout). An airfoil-file thickness path is rewritten
         relative to ``relative_to`` (a folder) when given."""
-        sec = {k: v for k, v in vars(self.section).items() if v is not None}
+        # smooth_airfoil is written only when set (off by default)
+        sec = {k: v for k, v in vars(self.section).items() if v is not None and not (k == "smooth_airfoil" and not v)}
+        if not self.section.smooth_airfoil or self.section.smooth_passes == DEFAULT_SMOOTH_PASSES:
+            sec.pop("smooth_passes", None)  # written only when it matters
         thickness = self.section.thickness
-        if self.base_dir is not None and relative_to is not None and thickness not in ("naca66mod", "naca4", "elliptic", "table"):
+        if self.base_dir is not None and relative_to is not None and thickness not in _THICKNESS_FORMS:
             absolute = (self.base_dir / thickness).resolve()
             sec["thickness"] = os.path.relpath(absolute, relative_to).replace(os.sep, "/")
         sec = {k: list(v) if isinstance(v, tuple) else v for k, v in sec.items()}

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 import pathlib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -37,6 +37,9 @@ class Airfoil:
     lower: (m, 2) pressure (lower) side from the leading edge (0, 0) to the trailing edge.
     format: "selig", "reverse-selig" or "lednicer" (as detected).
     path: the file read.
+    smoothing_deviation: for an outline smoothed by :func:`smoothed_airfoil`, the largest
+    distance between the smoothed and the unsmoothed curve, as a fraction of the chord
+    (Hvid 1993 §3.2, measured both ways by closest point); None when not smoothed.
     """
 
     name: str
@@ -44,6 +47,7 @@ class Airfoil:
     lower: np.ndarray
     format: str
     path: str = ""
+    smoothing_deviation: float | None = None
 
     @property
     def outline(self) -> np.ndarray:
@@ -111,6 +115,27 @@ def _check_duplicates(points: np.ndarray, lines: np.ndarray, path: pathlib.Path)
         )
 
 
+def _normalised_sides(outline: np.ndarray, te_mid: np.ndarray, path) -> tuple[np.ndarray, np.ndarray]:
+    """The two sides of ``outline`` (TE -> LE -> TE), each from the leading edge (the point
+    farthest from the trailing-edge midpoint ``te_mid``) to its trailing-edge end, at unit
+    chord: the leading edge at (0, 0), ``te_mid`` at (1, 0). First the side listed first."""
+    dist = np.linalg.norm(outline - te_mid, axis=1)
+    i_le = int(np.argmax(dist))
+    if i_le == 0 or i_le == len(outline) - 1:
+        raise DefinitionError("cannot find a leading edge between the two trailing-edge ends", path=str(path))
+    first, second = outline[: i_le + 1][::-1], outline[i_le:]
+    le = outline[i_le]
+    chord_vec = te_mid - le
+    chord = float(np.hypot(*chord_vec))
+    cos_a, sin_a = chord_vec / chord
+    rot = np.array([[cos_a, sin_a], [-sin_a, cos_a]])
+
+    def normalise(p):
+        return ((p - le) @ rot.T) / chord
+
+    return normalise(first), normalise(second)
+
+
 def read_airfoil(path) -> Airfoil:
     """Read an airfoil .dat file (format auto-detected) and normalise it to unit chord."""
     path = pathlib.Path(path)
@@ -140,22 +165,7 @@ def read_airfoil(path) -> Airfoil:
         te_mid = 0.5 * (pts[0] + pts[-1])
         outline = pts
         fmt = "selig"
-    # leading edge: the point farthest from the trailing-edge midpoint
-    dist = np.linalg.norm(outline - te_mid, axis=1)
-    i_le = int(np.argmax(dist))
-    if i_le == 0 or i_le == len(outline) - 1:
-        raise DefinitionError("cannot find a leading edge between the two trailing-edge ends", path=str(path))
-    first, second = outline[: i_le + 1][::-1], outline[i_le:]
-    le = outline[i_le]
-    chord_vec = te_mid - le
-    chord = float(np.hypot(*chord_vec))
-    cos_a, sin_a = chord_vec / chord
-    rot = np.array([[cos_a, sin_a], [-sin_a, cos_a]])
-
-    def normalise(p):
-        return ((p - le) @ rot.T) / chord
-
-    first, second = normalise(first), normalise(second)
+    first, second = _normalised_sides(outline, te_mid, path)
     if is_lednicer:
         upper, lower = first, second
     else:
@@ -167,6 +177,31 @@ def read_airfoil(path) -> Airfoil:
             upper, lower = second, first
             fmt = "reverse-selig"
     return Airfoil(name=name, upper=upper, lower=lower, format=fmt, path=str(path))
+
+
+def airfoil_from_outline(outline, name: str, format: str = "selig", path: str = "") -> Airfoil:
+    """An :class:`Airfoil` from outline points in Selig order (TE, upper side, LE, lower
+    side, TE), normalised to unit chord the way :func:`read_airfoil` normalises a file:
+    the leading edge is the point farthest from the trailing-edge midpoint."""
+    outline = np.asarray(outline, dtype=np.float64)
+    upper, lower = _normalised_sides(outline, 0.5 * (outline[0] + outline[-1]), path)
+    return Airfoil(name=name, upper=upper, lower=lower, format=format, path=str(path))
+
+
+def smoothed_airfoil(airfoil: Airfoil, **options) -> Airfoil:
+    """``airfoil`` with its outline smoothed by Hvid's smoothfoil (Hvid 1993, DTU AFM 93-08;
+    :func:`~..fairing.hvid.smooth_airfoil_result`, default jobcard unless ``options`` give
+    :class:`~..fairing.hvid.SmoothingSettings` fields), renormalised to unit chord; name,
+    format and path are kept, and ``smoothing_deviation`` is set. A blunt trailing edge
+    stays blunt (cut back at its ends).
+
+    Raises :class:`~..fairing.hvid.SmoothingNotConverged` (a GeometryError) when the
+    iteration does not converge, GeometryError when the outline cannot be smoothed."""
+    from ..fairing.hvid import smooth_airfoil_result  # the fairing package imports this module
+
+    result = smooth_airfoil_result(airfoil.outline, **options)
+    out = airfoil_from_outline(result.points, airfoil.name, airfoil.format, airfoil.path)
+    return replace(out, smoothing_deviation=float(result.deviation.true))
 
 
 def _surface_at(surface: np.ndarray, x: np.ndarray) -> np.ndarray:

@@ -41,9 +41,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import BSpline, CubicSpline, make_interp_spline
 
-from ..errors import DefinitionError
+from ..errors import BladesmithError, DefinitionError
 from . import naca, tables
-from .airfoil_file import Airfoil, read_airfoil, thickness_and_camber
+from .airfoil_file import Airfoil, read_airfoil, smoothed_airfoil, thickness_and_camber
 
 #: ψ-uniform nodes on [0, π] used to sample formula and airfoil-file thicknesses.
 FORMULA_NODES = 48
@@ -103,6 +103,26 @@ def _closed_thickness_spline(x_nodes: np.ndarray, t_nodes: np.ndarray, what: str
     return CubicSpline(nodes, values / (-2.0 * s_min), bc_type="periodic")
 
 
+#: Passes of Hvid's ad hoc curvature smoother when a definition asks for its airfoil to be
+#: smoothed: the paper's fx66-s-196 jobcard (§3.2.1). Fewer passes stay closer to the file.
+DEFAULT_SMOOTH_PASSES = 4
+#: Largest number of passes a definition may ask for.
+MAX_SMOOTH_PASSES = 50
+
+
+def _smoothed(airfoil: Airfoil, source=None, passes: int = DEFAULT_SMOOTH_PASSES) -> Airfoil:
+    """``airfoil`` smoothed by Hvid's smoothfoil (``passes`` passes of the ad hoc
+    smoother); a failure names the airfoil file."""
+    try:
+        return smoothed_airfoil(airfoil, passes=int(passes))
+    except BladesmithError as exc:  # SmoothingNotConverged (a GeometryError) among them
+        raise DefinitionError(
+            f"the airfoil {airfoil.path!r} could not be smoothed (Hvid 1993 smoothfoil): {exc}",
+            field="section.smooth_airfoil",
+            path=source,
+        ) from exc
+
+
 def _meanline_spline(x_nodes, f_nodes, what: str, source=None) -> BSpline:
     x = np.asarray(x_nodes, dtype=np.float64)
     f = np.asarray(f_nodes, dtype=np.float64)
@@ -144,11 +164,14 @@ class SectionShape:
     thickness: the periodic spline S(ψ) (signed half-thickness, max thickness 1).
     meanline: the spline F(x) (max 1), or None for an uncambered section.
     name: "thickness / meanline" for messages.
+    smoothing_deviation: with ``smooth_airfoil``, the smoothed outline's largest distance
+    from the file's, as a fraction of chord (see ``Airfoil.smoothing_deviation``); else None.
     """
 
     thickness: CubicSpline
     meanline: BSpline | None
     name: str = ""
+    smoothing_deviation: float | None = None
     _camber_derivatives: tuple = field(default=(), repr=False)
 
     def __post_init__(self):
@@ -159,7 +182,7 @@ class SectionShape:
     # -- construction ----------------------------------------------------------------
     @classmethod
     def from_spec(cls, thickness: str, meanline: str, base_dir=None, thickness_table=None, meanline_table=None,
-                  source=None):
+                  source=None, smooth_airfoil: bool = False, smooth_passes: int = DEFAULT_SMOOTH_PASSES):
         """Build from the [section] names of a propeller definition.
 
         thickness: "naca66mod", "naca4", "elliptic", "table" (``thickness_table`` = (x_c,
@@ -168,9 +191,20 @@ class SectionShape:
         "none", "table" (``meanline_table`` = (x_c, f/f0)) or "airfoil" (the mean line of
         the airfoil file given as thickness).
         source: the definition file, named in error messages.
+        smooth_airfoil: smooth the airfoil file's outline first (Hvid 1993 smoothfoil with
+        its default jobcard, :func:`.airfoil_file.smoothed_airfoil`); only for an airfoil
+        file. A smoothing that does not converge is a DefinitionError naming the file.
+        smooth_passes: passes of the ad hoc smoother (default the paper's 4).
         """
         airfoil: Airfoil | None = None
         key = thickness.strip()
+        if smooth_airfoil and key in THICKNESS_NAMES:
+            raise DefinitionError(
+                f"smooth_airfoil smooths an airfoil file's outline, but thickness = {thickness!r} is not an "
+                "airfoil .dat file",
+                field="section.smooth_airfoil",
+                path=source,
+            )
         if key == "naca66mod":
             S = _closed_thickness_spline(tables.NACA66MOD_X, tables.NACA66MOD_T, "naca66mod", source)
         elif key in ("naca4", "elliptic"):
@@ -193,6 +227,8 @@ class SectionShape:
                     path=source,
                 )
             airfoil = read_airfoil(path)
+            if smooth_airfoil:
+                airfoil = _smoothed(airfoil, source, smooth_passes)
             xs = _x_of_psi(np.linspace(0.0, np.pi, FORMULA_NODES + 1))
             t, _ = thickness_and_camber(airfoil, xs)
             try:
@@ -227,7 +263,9 @@ class SectionShape:
                 f"meanline = {meanline!r}: expected one of {', '.join(MEANLINE_NAMES)}", field="section.meanline",
                 path=source,
             )
-        return cls(thickness=S, meanline=F, name=f"{thickness} / {meanline}")
+        name = f"{thickness} (smoothed) / {meanline}" if smooth_airfoil else f"{thickness} / {meanline}"
+        deviation = airfoil.smoothing_deviation if airfoil is not None else None
+        return cls(thickness=S, meanline=F, name=name, smoothing_deviation=deviation)
 
     # -- evaluation ------------------------------------------------------------------
     def half_thickness(self, psi, nu: int = 0) -> np.ndarray:

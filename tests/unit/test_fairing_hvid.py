@@ -309,3 +309,31 @@ def test_bad_outline_refused():
         smoothfoil(np.array([[1, 0], [0.5, -0.05], [0.5, -0.05], [0, 0], [0.5, 0.05], [1, 0]], float))
     with pytest.raises(GeometryError, match="not finite"):
         smoothfoil(np.array([[1, 0], [0.5, np.nan], [0, 0], [0.3, 0.05], [0.5, 0.05], [1, 0]], float))
+
+
+def test_blunt_trailing_edge_whose_tangents_do_not_meet_is_extended_gently():
+    """§3.3 step 1 with parallel or diverging end tangents (thick blunt sections): each end
+    is extended along its own tangent and bent onto a common apex, so the kept outline
+    keeps its end tangents and the extension curves gently (about gap / L²)."""
+    from bladesmith.geometry.fairing import hvid
+
+    x = 0.5 * (1 - np.cos(np.linspace(0.0, np.pi, 60)))
+    for slope in (0.0, -0.02):  # parallel, then diverging towards the trailing edge
+        thick = 0.12 * np.sqrt(x) * (1 - x) + 0.004 * x + slope * np.maximum(x - 0.9, 0) ** 2 / 0.2
+        upper = np.column_stack([x, thick])
+        lower = np.column_stack([x, -thick])
+        outline = np.concatenate([upper[::-1], lower[1:]])
+        ext, k0, k1 = hvid._extend_trailing_edge(outline, 2)
+        assert np.array_equal(ext[k0: len(ext) - k1], outline)
+        assert np.allclose(ext[0], ext[-1])  # one apex: a sharp trailing edge to smooth
+        gap = float(np.linalg.norm(outline[0] - outline[-1]))
+        L = np.clip(hvid.TE_EXTENSION_GAPS * gap, hvid.MIN_TE_EXTENSION, hvid.MAX_TE_FALLBACK)
+        assert ext[0, 0] == pytest.approx(1.0 + L, rel=0.05)
+        # the first extension step leaves the trailing edge along the end tangent
+        spline, _ = hvid.spline_through(outline, 2)
+        t_end = spline.derivatives(spline.domain[1], 1)[1]
+        step = ext[k0 + len(outline)] - outline[-1]
+        cos = step @ t_end / np.linalg.norm(step) / np.linalg.norm(t_end)
+        assert cos > np.cos(np.radians(1.0))
+        r = hvid.smoothfoil(outline)
+        assert r.converged and np.linalg.norm(r.points[0] - r.points[-1]) == pytest.approx(gap, rel=0.05)
