@@ -245,28 +245,32 @@ def _curve_brackets(P, ts, C0, C1, k):
 
 def _curve_brackets_near(P, ts, C0, C1, k):
     """:func:`_curve_brackets` restricted to the sample intervals near each point, with the
-    same result: the interval holding the closest point C(u*) has its nearer end within
-    d* + (its arc) <= d0 + 2 h of P, where d0 is the distance to the nearest sample and h
-    the longest sample chord (the samples turn by at most :data:`CURVE_SAMPLE_TURN`, so
-    an interval's arc is within 1 % of its chord); every interval ranked above it is
-    nearer still. So the k best brackets are among the intervals with an end in the ball
-    of radius d0 + 2 h, found with a k-d tree (``scipy.spatial.cKDTree``)."""
+    same result. Let C(u*) be the closest point, d* its distance, d0 the distance to the
+    nearest sample and h the longest sample chord. The end of u*'s interval nearer to u*
+    along the curve is within half the interval's arc of C(u*), so within d* + h/2 (1.07)
+    of P (the samples turn by at most :data:`CURVE_SAMPLE_TURN`: an interval's arc is at
+    most 1/cos 20° of its chord); every interval ranked above it has an end nearer still.
+    So the k best brackets are among the intervals with an end in the ball of radius
+    d0 + h (twice the margin needed), found with a k-d tree (``scipy.spatial.cKDTree``)."""
     from scipy.spatial import cKDTree
 
     M, nP = ts.size, P.shape[0]
     tree = cKDTree(C0)
     d0, j = tree.query(P)
     h = float(np.max(np.linalg.norm(np.diff(C0, axis=0), axis=1)))
-    balls = tree.query_ball_point(P, d0 + 2.0 * h, return_sorted=False)
+    balls = tree.query_ball_point(P, d0 + h, return_sorted=True)
     lens = np.fromiter(map(len, balls), dtype=np.int64, count=nP)
     pid = np.repeat(np.arange(nP), lens)
     sid = np.fromiter(itertools.chain.from_iterable(balls), dtype=np.int64, count=int(lens.sum()))
-    # intervals touching a sample in the ball (interval i joins samples i and i + 1)
-    iv = np.concatenate([sid - 1, sid])
-    pv = np.concatenate([pid, pid])
+    # intervals with an end in the ball (interval i joins samples i and i + 1), each once:
+    # i = s - 1 for every sample s, and i = s when s + 1 is not the next sample listed
+    nxt = np.r_[sid[1:], -1]
+    same = np.r_[pid[1:] == pid[:-1], False]
+    last = ~(same & (nxt == sid + 1))
+    iv = np.concatenate([sid - 1, sid[last]])
+    pv = np.concatenate([pid, pid[last]])
     keep = (iv >= 0) & (iv <= M - 2)
-    key = np.unique(pv[keep] * M + iv[keep])
-    pv, iv = key // M, key % M
+    pv, iv = pv[keep], iv[keep]
     cc = np.einsum("sd,sd->s", C1, C0)
     g2 = np.einsum("sd,sd->s", C0, C0)
     Pp = P[pv]
