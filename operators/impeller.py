@@ -6,7 +6,10 @@ property group of :mod:`..ui.impeller_panel`); its children are SURFACE objects 
 the exact surfaces of :func:`~..geometry.compressor.export.impeller_surfaces` (channel
 walls as four quarter surfaces of revolution each, blade k's S, P and rounded end patches,
 splitters), each storing its float64 surface, so File > Export > IGES writes them exactly.
-With ``blade_net`` a MESH object shows the (u, v) net of the camber surface B.
+With ``blade_net`` a MESH object shows the (u, v) net of the camber surface B. A
+definition with a ``[standardisation]`` table (Casey 1983, Fig. 11) shows its new channel
+and the blades trimmed to it; the operator reports the largest edge-to-wall distance and
+the knot counts of the trimmed surfaces.
 Editing a value in the panel rebuilds the model and replaces the children.
 """
 import pathlib
@@ -64,14 +67,17 @@ def _child(root, name: str, data, collection):
     return obj
 
 
-def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_net: bool) -> None:
-    """Build the model and make the root's children show it; raises BladesmithError.
+def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_net: bool, model=None):
+    """Build the model (unless given) and make the root's children show it; returns the
+    model; raises BladesmithError.
 
     The channel walls and the first blade (and splitter) are written in place into the
     existing objects (:func:`write_surface` reuses their curve data); blades 2..Z are
     linked copies of the first, rotated about the axis, so a panel edit rewrites one
-    blade, not Z. Children no longer needed are removed."""
-    model = definition.build()
+    blade, not Z. Children no longer needed are removed. A standardised definition shows
+    the new channel and the trimmed blades (and the trimmed camber surface's net)."""
+    if model is None:
+        model = definition.build()
     reference = impeller_surfaces(model, 1, include_camber=True)
     existing = {child.get(PART_KEY): child for child in root.children}
     collection = root.users_collection[0]
@@ -106,11 +112,16 @@ def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_
         if name not in wanted:
             remove_object(obj)
     if show_net:
-        net = blade_net(model.blade.camber, distribution(41, 1.5, 1.5), distribution(11))
+        u, v = distribution(41, 1.5, 1.5), distribution(11)
+        if model.standardisation is None:
+            net = blade_net(model.blade.camber, u, v)
+        else:
+            net = model.standardisation.trimmed("blade", "B").exact.net(u, v)
         obj = net_to_mesh(net, f"{root.name} net B", collection)
         obj[PART_KEY] = "net B"
         obj.parent = root
     root["definition_toml"] = dumps_toml(definition.to_dict())
+    return model
 
 
 class BLADESMITH_OT_add_impeller(bpy.types.Operator):
@@ -132,7 +143,7 @@ class BLADESMITH_OT_add_impeller(bpy.types.Operator):
     def execute(self, context):
         try:
             definition = load_definition(self.definition, self.preset)
-            definition.build()  # validate before touching the scene
+            model = definition.build()  # validate before touching the scene
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
@@ -140,27 +151,31 @@ class BLADESMITH_OT_add_impeller(bpy.types.Operator):
         context.collection.objects.link(root)
         root[ROOT_KEY] = True
         try:
-            build_children(root, definition, self.full_wheel, self.blade_net)
+            build_children(root, definition, self.full_wheel, self.blade_net, model)
         except BladesmithError as exc:
             for child in list(root.children):
                 bpy.data.objects.remove(child)
             bpy.data.objects.remove(root)
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
+        summary = "" if model.standardisation is None else model.standardisation.summary()
         settings = getattr(root, "bladesmith_impeller", None)
         if settings is not None:
-            settings.load(definition, self.full_wheel)
+            settings.load(definition, self.full_wheel, summary)
         for obj in context.view_layer.objects:
             obj.select_set(False)
         root.select_set(True)
         context.view_layer.objects.active = root
+        if summary:
+            self.report({"INFO"}, f"{definition.name}: {summary}")
         return {"FINISHED"}
 
 
-def regenerate(root, definition_dict: dict, full_wheel: bool) -> None:
-    """Rebuild a root's children from an edited definition dictionary (panel edits)."""
+def regenerate(root, definition_dict: dict, full_wheel: bool):
+    """Rebuild a root's children from an edited definition dictionary (panel edits);
+    returns the model."""
     definition = ImpellerDefinition.from_dict(definition_dict)
-    build_children(root, definition, full_wheel, any(c.get(PART_KEY) == "net B" for c in root.children))
+    return build_children(root, definition, full_wheel, any(c.get(PART_KEY) == "net B" for c in root.children))
 
 
 def definition_from_root(root) -> dict:

@@ -61,6 +61,7 @@ from ..geometry.propeller.definition import RADIAL_FIELDS
 from ..geometry.propeller.display import DISPLAY_TOLERANCE_FRACTION, blade_display_surface, hub_surface
 from .progress import progress_callback
 from .nurbs_objects import PROPERTY_KEY, remove_object, write_surface
+from .values import typed
 
 #: The extension package (``bladesmith`` from a checkout, ``bl_ext.<repo>.bladesmith``
 #: when installed).
@@ -274,12 +275,6 @@ def updates_suspended() -> bool:
     return _suspended > 0
 
 
-def _decimal(value: float) -> float:
-    """Blender keeps FloatProperty values as float32; the shortest decimal that rounds to
-    the same float32 is what the user typed (0.09016, not 0.09015999734401703)."""
-    return float(str(np.float32(value)))
-
-
 def settings_to_dict(settings) -> dict:
     """The definition (TOML layout) of a property group."""
     kind = settings.thickness_kind
@@ -292,27 +287,27 @@ def settings_to_dict(settings) -> dict:
         section["smooth_airfoil"] = True
         section["smooth_passes"] = int(settings.smooth_passes)
     if kind == "TABLE":
-        section["thickness_x_c"] = [_decimal(row.x_c) for row in settings.thickness_table]
-        section["thickness_t"] = [_decimal(row.value) for row in settings.thickness_table]
+        section["thickness_x_c"] = [typed(row.x_c) for row in settings.thickness_table]
+        section["thickness_t"] = [typed(row.value) for row in settings.thickness_table]
     if settings.meanline == "TABLE":
-        section["meanline_x_c"] = [_decimal(row.x_c) for row in settings.meanline_table]
-        section["meanline_f"] = [_decimal(row.value) for row in settings.meanline_table]
+        section["meanline_x_c"] = [typed(row.x_c) for row in settings.meanline_table]
+        section["meanline_f"] = [typed(row.value) for row in settings.meanline_table]
     return {
         "name": settings.definition_name,
         "blades": int(settings.blades),
-        "diameter": _decimal(settings.diameter),
-        "hub_diameter_ratio": _decimal(settings.hub_diameter_ratio),
+        "diameter": typed(settings.diameter),
+        "hub_diameter_ratio": typed(settings.hub_diameter_ratio),
         "hand": settings.hand.lower(),
         "section": section,
         "hub": {
-            "upstream_length": _decimal(settings.hub_upstream_length),
-            "downstream_length": _decimal(settings.hub_downstream_length),
+            "upstream_length": typed(settings.hub_upstream_length),
+            "downstream_length": typed(settings.hub_downstream_length),
             "nose_shape": settings.hub_nose_shape.lower(),
-            "nose_length": _decimal(settings.hub_nose_length),
+            "nose_length": typed(settings.hub_nose_length),
             "tail_shape": settings.hub_tail_shape.lower(),
-            "tail_length": _decimal(settings.hub_tail_length),
+            "tail_length": typed(settings.hub_tail_length),
         },
-        "radial": {name: [_decimal(getattr(row, name)) for row in settings.radial] for name in RADIAL_FIELDS},
+        "radial": {name: [typed(getattr(row, name)) for row in settings.radial] for name in RADIAL_FIELDS},
     }
 
 

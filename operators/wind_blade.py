@@ -57,6 +57,7 @@ from ..iges import surface_from_geometry, write_iges
 from . import nurbs_objects
 from .progress import progress_callback
 from .nurbs_objects import remove_object, write_curve, write_surface
+from .values import typed
 
 #: Custom property naming a child's part (a key of BladeMolds.surfaces / parting_lines, or "single").
 PART_KEY = "bladesmith_mold_part"
@@ -131,27 +132,21 @@ def suspended_updates():
         _suspended -= 1
 
 
-def _typed(value: float) -> float:
-    """A FloatProperty holds float32: the shortest decimal that rounds to it is what the
-    user typed (61.6333, not 61.633300781)."""
-    return float(str(np.float32(value)))
-
-
 def settings_to_dict(settings) -> dict:
     """The definition (TOML layout of ``geometry.mold.definition``) of a property group."""
     rows = settings.stations
     return {
         "name": settings.definition_name,
-        "hub_radius": _typed(settings.hub_radius),
-        "mold_direction": [_typed(x) for x in settings.mold_direction],
+        "hub_radius": typed(settings.hub_radius),
+        "mold_direction": [typed(x) for x in settings.mold_direction],
         "wrap": bool(settings.wrap),
         "first_aerodynamic_station": int(settings.first_aerodynamic_station),
         "control_points": int(settings.control_points),
-        "tolerance": _typed(settings.tolerance),
+        "tolerance": typed(settings.tolerance),
         "smooth_airfoils": bool(settings.smooth_airfoils),
         "smooth_passes": int(settings.smooth_passes),
         "stations": {
-            **{name: [_typed(getattr(row, name)) for row in rows] for name in STATION_FIELDS},
+            **{name: [typed(getattr(row, name)) for row in rows] for name in STATION_FIELDS},
             "airfoil": [row.airfoil.strip() for row in rows],
         },
     }
@@ -422,7 +417,7 @@ class BLADESMITH_OT_add_wind_blade(bpy.types.Operator):
         wm.progress_begin(0, 100)
         try:
             start = time.perf_counter()
-            tolerance = _typed(self.tolerance)  # the float32 property as typed
+            tolerance = typed(self.tolerance)  # the float32 property as typed
             check_fit_settings(self.control_points, tolerance)
             defn = _override(load_definition(self.definition, self._preset_name()), self.control_points, tolerance)
             molds = compute_molds(defn, fairness=self.fairness, progress=progress_callback(wm))

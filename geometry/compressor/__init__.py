@@ -7,7 +7,8 @@ ASME J. Eng. Power.
 - :mod:`.blade`: B, S and P blade surfaces from β(m) and δ(m) (Appendix A1–A5);
 - :mod:`.definition`: TOML definitions and the impeller model;
 - :mod:`.fitting`: approximating existing impellers (DLR SRV2-O);
-- :mod:`.uses`: nets, axial sections, standardisation, rulings.
+- :mod:`.uses`: nets, axial sections, standardisation, rulings;
+- :mod:`.standardisation`: standardised (trimmed) blades as B-spline surfaces (Fig. 11).
 """
 from .bezier import BezierCurve, BezierString, PatchString, RuledPatch, bernstein
 from .blade import BladeSurfaces, build_blade, casey_shooting, cubic_string_through, surface_end_angles

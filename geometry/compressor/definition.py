@@ -37,6 +37,12 @@ Format (lengths in metres, angles in degrees; see README "Impeller definition"):
     thickness_shroud = [...]
     pitch_fraction = 0.5           # φ offset in blade pitches 2π/Z
     patches = 4
+
+    [standardisation]              # optional (Casey 1983, Fig. 11): trim to a new channel
+    shroud_factor = 0.8            # new shroud = hub + 0.8 (shroud - hub): a 20 % shroud cut
+    hub_factor = 1.0               # new hub = shroud + f (hub - shroud): < 1 a hub cut
+
+See :class:`StandardisationDefinition` for why the factors have a table of their own.
 """
 from __future__ import annotations
 
@@ -46,9 +52,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import DefinitionError
+from ..errors import DefinitionError, GeometryError
 from .blade import MAX_BETA_DEG, BladeSurfaces, WallBlade, WallCamber, build_blade
 from .channel import MeridionalChannel, WallSkeleton, channel_from_skeleton
+from .standardisation import Standardisation
+from .uses import CutError, scaled_channel
 
 WALLS = ("hub", "shroud")
 
@@ -224,19 +232,97 @@ class SplitterDefinition:
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
 
 
+#: Each standardisation factor must lie in (FACTOR_MIN, FACTOR_MAX].
+FACTOR_MIN = 0.3
+FACTOR_MAX = 1.5
+#: The new channel keeps at least this fraction of the master's width:
+#: shroud_factor + hub_factor - 1 >= MIN_WIDTH_FRACTION.
+MIN_WIDTH_FRACTION = 0.3
+STANDARDISATION_KEYS = ("shroud_factor", "hub_factor")
+
+
+@dataclass(frozen=True)
+class StandardisationDefinition:
+    """Casey's (1983) standardisation, items a–d and Fig. 11: the master impeller (the
+    [channel] and [blade] tables, Casey's M') is trimmed to a new meridional channel M
+    made by :func:`.uses.scaled_channel`, new shroud = hub + shroud_factor (shroud - hub)
+    and new hub = shroud + hub_factor (hub - shroud), both along the master channel's
+    straight v lines; the blade surfaces are cut by the new walls along their rulings
+    (extrapolated linearly in v where M is wider).
+
+    The factors have a table of their own rather than living in [channel] because they do
+    not describe a channel: [channel] stays the master's skeletal data, which the panel
+    edits and from which the blades are built, and the standardisation is an operation
+    applied afterwards to the finished master impeller (Casey uses one master blade for a
+    family of channels). Removing the table restores the master exactly, and the same
+    master data serve every member of the family.
+
+    Both default to 1 (no cut); each must lie in (FACTOR_MIN, FACTOR_MAX] and together they
+    must leave MIN_WIDTH_FRACTION of the master channel's width."""
+
+    shroud_factor: float = 1.0
+    hub_factor: float = 1.0
+
+    @classmethod
+    def from_dict(cls, data, path=None) -> "StandardisationDefinition":
+        if not isinstance(data, dict):
+            raise DefinitionError(f"expected a table, got {data!r}", path=path, field="standardisation")
+        unknown = sorted(set(data) - set(STANDARDISATION_KEYS))
+        if unknown:
+            raise DefinitionError(f"unknown key {unknown[0]!r}; expected {', '.join(STANDARDISATION_KEYS)}",
+                                  path=path, field=f"standardisation.{unknown[0]}")
+        values = {k: _number(data, k, "standardisation", path, 1.0) for k in STANDARDISATION_KEYS}
+        out = cls(**values)
+        out.check(path)
+        return out
+
+    def check(self, path=None) -> None:
+        for key in STANDARDISATION_KEYS:
+            value = getattr(self, key)
+            if not (math.isfinite(value) and FACTOR_MIN < value <= FACTOR_MAX):
+                raise DefinitionError(f"must lie in ({FACTOR_MIN}, {FACTOR_MAX}], got {value!r}",
+                                      path=path, field=f"standardisation.{key}")
+        width = self.shroud_factor + self.hub_factor - 1.0
+        if width < MIN_WIDTH_FRACTION:
+            key = "hub_factor" if self.hub_factor != 1.0 else "shroud_factor"
+            raise DefinitionError(
+                f"shroud_factor {self.shroud_factor!r} and hub_factor {self.hub_factor!r} leave {width:.3g} of the "
+                f"channel width; at least {MIN_WIDTH_FRACTION} is needed", path=path, field=f"standardisation.{key}")
+
+    @property
+    def is_identity(self) -> bool:
+        return self.shroud_factor == 1.0 and self.hub_factor == 1.0
+
+    def to_dict(self) -> dict:
+        """The table, keys at 1.0 omitted (empty for no standardisation)."""
+        return {k: getattr(self, k) for k in STANDARDISATION_KEYS if getattr(self, k) != 1.0}
+
+
 @dataclass(frozen=True, eq=False)
 class ImpellerModel:
     """The float64 model: channel M, the reference blade (B, S, P at φ as defined), the
-    splitter (or None) and the blade count Z. Blade k is the reference turned by 2πk/Z."""
+    splitter (or None) and the blade count Z. Blade k is the reference turned by 2πk/Z.
+
+    Standardised (Casey 1983, Fig. 11): ``channel`` is the new channel M, ``blade`` and
+    ``splitter`` stay the master's surfaces (built in the master channel,
+    ``standardisation.master_channel``), and ``standardisation`` holds their trimmed
+    B-spline surfaces (:class:`.standardisation.Standardisation`), which
+    :func:`.export.impeller_surfaces` shows and exports. None when not standardised."""
 
     name: str
     channel: MeridionalChannel
     blade: BladeSurfaces
     splitter: BladeSurfaces | None
     count: int
+    standardisation: Standardisation | None = None
 
     def blade_angle(self, k: int) -> float:
         return 2.0 * math.pi * k / self.count
+
+    @property
+    def master_channel(self) -> MeridionalChannel:
+        """The channel the blades were designed in (M'; ``channel`` when not standardised)."""
+        return self.channel if self.standardisation is None else self.standardisation.master_channel
 
 
 @dataclass(frozen=True)
@@ -246,6 +332,7 @@ class ImpellerDefinition:
     blade: BladeDefinition
     splitter: SplitterDefinition | None = None
     path: str | None = field(default=None, compare=False)
+    standardisation: StandardisationDefinition | None = None  # None: the master itself
 
     @classmethod
     def from_dict(cls, data: dict, path=None) -> "ImpellerDefinition":
@@ -255,12 +342,18 @@ class ImpellerDefinition:
         if not isinstance(data.get("blade"), dict):
             raise DefinitionError("missing [blade] table", path=path, field="blade")
         splitter = data.get("splitter")
+        standardisation = None
+        if "standardisation" in data:
+            standardisation = StandardisationDefinition.from_dict(data["standardisation"], path)
+            if standardisation.is_identity:
+                standardisation = None
         return cls(
             name=str(data.get("name", "Impeller")),
             channel=ChannelDefinition.from_dict(data["channel"], path),
             blade=BladeDefinition.from_dict(data["blade"], path),
             splitter=None if splitter is None else SplitterDefinition.from_dict(splitter, path),
             path=path,
+            standardisation=standardisation,
         )
 
     @classmethod
@@ -278,6 +371,8 @@ class ImpellerDefinition:
         out = {"name": self.name, "channel": self.channel.to_dict(), "blade": self.blade.to_dict()}
         if self.splitter is not None:
             out["splitter"] = self.splitter.to_dict()
+        if self.standardisation is not None and not self.standardisation.is_identity:
+            out["standardisation"] = self.standardisation.to_dict()
         return out
 
     def with_values(self, **changes) -> "ImpellerDefinition":
@@ -345,7 +440,44 @@ class ImpellerDefinition:
                 for w in WALLS
             }
             splitter = build_blade(channel, swalls["hub"], swalls["shroud"], s.patches, axial, s.leading_edge_ratio, b.trailing_edge_ratio)
-        return ImpellerModel(self.name, channel, blade, splitter, b.count)
+        st = self.standardisation
+        if st is None or st.is_identity:
+            return ImpellerModel(self.name, channel, blade, splitter, b.count)
+        standardisation = self._standardise(channel, blade, splitter)
+        return ImpellerModel(self.name, standardisation.channel, blade, splitter, b.count, standardisation)
+
+    def _standardise(self, master: MeridionalChannel, blade: BladeSurfaces, splitter) -> Standardisation:
+        """The new channel and the trimmed blades (Casey 1983, Fig. 11); failures are
+        reported against the factor of the wall concerned."""
+        st, p = self.standardisation, self.path
+        st.check(p)
+
+        def field_of(wall: str) -> str:
+            if wall == "hub" and st.hub_factor != 1.0:
+                return "standardisation.hub_factor"
+            if wall == "shroud" and st.shroud_factor != 1.0:
+                return "standardisation.shroud_factor"
+            # the wall concerned did not move: the factor that did is to blame
+            return "standardisation.shroud_factor" if st.shroud_factor != 1.0 else "standardisation.hub_factor"
+
+        channel = scaled_channel(master, st.shroud_factor, st.hub_factor)
+        try:
+            channel.check(p)
+        except DefinitionError as exc:
+            raise DefinitionError(f"the new channel is invalid: {str(exc).rsplit(chr(39) + ': ', 1)[-1]}", path=p,
+                                  field=field_of("shroud")) from None
+        blades = {"blade": blade} if splitter is None else {"blade": blade, "splitter": splitter}
+        values = f"shroud_factor = {st.shroud_factor!r}"
+        if st.hub_factor != 1.0:
+            values += f", hub_factor = {st.hub_factor!r}"
+        try:
+            return Standardisation(master, channel, st.shroud_factor, st.hub_factor, blades)
+        except CutError as exc:
+            raise DefinitionError(f"cannot standardise with {values}: {exc}", path=p,
+                                  field=field_of(exc.wall)) from None
+        except GeometryError as exc:
+            raise DefinitionError(f"cannot standardise with {values}: {exc}", path=p,
+                                  field=field_of("shroud")) from None
 
 
 def dumps_toml(data: dict, header: str = "") -> str:

@@ -3,6 +3,8 @@
 Channel walls: rational surfaces of revolution of degree (p, 2) (IGES 128); blades: the
 S and P patch strings and the rounded end patches as degree (3, 1) B-splines (IGES 128,
 Casey's cubic-linear patches), blade k turned by 2πk/Z (exact rotation of the polygons).
+A standardised impeller has the walls of its new channel and the trimmed blades of
+:mod:`.standardisation` (degree (3, 1) B-splines too).
 """
 from __future__ import annotations
 
@@ -97,13 +99,18 @@ def impeller_surfaces(model: ImpellerModel, blades: int | None = None, include_c
                       ) -> list[tuple[str, BSplineSurface]]:
     """(name, surface) pairs: "hub 1".."hub 4", "shroud 1".."shroud 4" (quarter
     walls, see :func:`channel_wall_quarters`), then "blade k S" ... for k = 1..blades (default all Z)
-    and "splitter k S" ... when the model has splitters."""
+    and "splitter k S" ... when the model has splitters.
+
+    A standardised model (Casey 1983, Fig. 11) gives the walls of its new channel and the
+    blades trimmed to it (:mod:`.standardisation`: degree (3, 1) B-splines whose edges lie
+    on the new walls to the standardisation tolerance), under the same names."""
     out = []
     for wall in ("hub", "shroud"):
         for i, surface in enumerate(channel_wall_quarters(model.channel.wall(wall))):
             out.append((f"{wall} {i + 1}", surface))
     count = model.count if blades is None else int(blades)
-    reference = {label: blade_surfaces(blade, include_camber)
+    st = model.standardisation
+    reference = {label: blade_surfaces(blade, include_camber) if st is None else st.surfaces(label, include_camber)
                  for label, blade in (("blade", model.blade), ("splitter", model.splitter)) if blade is not None}
     for k in range(count):
         c, s = np.cos(model.blade_angle(k)), np.sin(model.blade_angle(k))
