@@ -385,7 +385,10 @@ def _axial_shroud(channel: MeridionalChannel, lower: BezierString, shroud: WallB
         sign_change = np.nonzero(np.diff(np.sign(rs - r)) != 0)[0]
         if sign_change.size == 0:
             raise DefinitionError(f"the shroud contour never reaches r = {r:.6g} m needed by axial elements", field="blade.elements")
-        k = sign_change[0]
+        # the contour can reach r more than once (an inlet turning outwards before the
+        # passage): take the crossing nearest the blade's own span [U0, U1] on the shroud
+        mid = 0.5 * (Us[sign_change] + Us[sign_change + 1])
+        k = sign_change[np.argmin(np.maximum(shroud.U0 - mid, 0.0) + np.maximum(mid - shroud.U1, 0.0))]
         U = brentq(lambda t: wall.evaluate(t)[1] - r, Us[k], Us[k + 1], xtol=1e-15)
         zr, d = wall.derivatives(U, 1)
         if abs(d[1]) < 1e-12 * np.linalg.norm(d):

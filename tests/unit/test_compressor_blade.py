@@ -85,6 +85,13 @@ def test_axial_elements(models):
     L = rulings(m.blade.suction, np.linspace(0, 1, 33))
     d = L[:, 1] - L[:, 0]
     assert np.max(np.hypot(d[:, 0], d[:, 1])) < 1e-12
+    # the shroud edge follows the shroud wall of the passage, not the inlet that reaches
+    # the same radii upstream (it stood 9 mm off the wall when the first crossing was taken)
+    wall = m.channel.shroud.to_bspline()
+    for s in (m.blade.suction, m.blade.pressure, m.blade.camber):
+        X = s.upper.evaluate(np.linspace(0, s.count, 801))
+        zr = np.column_stack([X[:, 2], np.hypot(X[:, 0], X[:, 1])])
+        assert closest_point_curve(wall, zr)[1].max() < 1e-5  # the cubic z(r) between corners
 
 
 @pytest.mark.parametrize("factor", [0.8, 1.1])
