@@ -96,7 +96,7 @@ PARALLEL_TANGENT_TOL = 1e-12
 
 #: Samples per knot span when measuring the true deviation between curves and extremes
 #: of curvature.
-DEVIATION_SAMPLES_PER_SPAN = 6
+DEVIATION_SAMPLES_PER_SPAN = 4
 
 #: Weight of the kept maximum in the least-squares smoother of smoothing type 2 (relative
 #: to 1 for every other point): large enough to pin the fit to the value.

@@ -161,9 +161,17 @@ def closest_point_curve(
     ts, C0, C1 = _adaptive_curve_samples(curve, _span_samples(curve.knots, curve.degree, samples_per_span))
     k = max(1, int(candidates))
     lo, hi, start = _curve_brackets(P, ts, C0, C1, k)
+    # a point with fewer than k brackets has its best one repeated: refine each once
+    repeat = np.zeros(lo.shape, dtype=bool)
+    for j in range(1, k):
+        repeat[:, j] = np.any((lo[:, :j] == lo[:, j: j + 1]) & (hi[:, :j] == hi[:, j: j + 1]), axis=1)
+    todo = ~repeat.reshape(-1)
     Pk = np.repeat(P, k, axis=0)
-    u = _newton_curve(curve, Pk, start.reshape(-1), lo.reshape(-1), hi.reshape(-1), eps1, cos_tol, max_iterations)
-    dist = np.linalg.norm(curve.evaluate(u) - Pk, axis=1)
+    u = start.reshape(-1).copy()
+    u[todo] = _newton_curve(curve, Pk[todo], u[todo], lo.reshape(-1)[todo], hi.reshape(-1)[todo], eps1, cos_tol,
+                            max_iterations)
+    dist = np.full(u.shape, np.inf)
+    dist[todo] = np.linalg.norm(curve.evaluate(u[todo]) - Pk[todo], axis=1)
     rows = np.arange(P.shape[0]) * k + np.argmin(dist.reshape(-1, k), axis=1)
     return u[rows].reshape(shape), dist[rows].reshape(shape)
 
