@@ -41,6 +41,26 @@ upper + lower, single = one surface with 2n - 1 control points per section)::
 - Strain energy: two-part lower only at n = 6 and 10; above that the single surface is
   1-4 % lower. The paper's Fig. 11 claim is NOT reproduced for n >= 12 with these data.
 
+The same comparison on NREL 5-MW (data/blades/nrel5mw.toml: six airfoil families from
+DU 40 to NACA 64, twist 13.3° to 0°; aero zone)::
+
+     n   MVS two-part  MVS single   SE two-part  SE single
+     6   6.20e+04      6.42e+05     717.6        1044.2
+     8   1.56e+05      4.91e+05     892.3        986.8
+    10   2.57e+05      3.22e+05     969.0        940.1
+    12   2.98e+05      2.79e+05     983.7        954.6
+    14   2.76e+05      3.22e+05     979.5        978.4
+    16   2.55e+05      3.84e+05     978.8        990.4
+    20   2.84e+05      3.83e+05     986.6        991.0
+
+- MVS: two-part lower at 6 of 7 counts (not at n = 12), by up to 10x at n = 6.
+- Strain energy: lower at n = 6, 8, 16 and 20; within 3 % above at 10-14.
+Here, with the airfoil changing from station to station, the paper's Fig. 10 holds at
+all but one count. A likely reason (not isolated here): the single surface's common
+knots are averaged over sections whose silhouette points S sit at chord-length
+parameters 0.480-0.506 (S823 blade: 0.492-0.494), so its leading edge moves across knot
+spans from station to station, while each half always ends at S.
+
 Why, measured on one section (S823, unit chord, ``curve_fairness``: the curve forms of
 Eq. 6, CV = ∫(dκ/ds)² ds, BE = ∫κ² ds; "interp" is the cubic interpolant of the 199
 points, CV 6.70e+05, BE 62.41)::
@@ -189,3 +209,31 @@ def test_fig11_two_part_strain_energy_is_the_better_resolved():
     assert np.all(np.abs(from_8[:, 3] - ref.bending_energy) < np.abs(from_8[:, 4] - ref.bending_energy))
     # and both converge to it
     assert abs(rows[-1, 3] / ref.bending_energy - 1) < 0.01 and abs(rows[-1, 4] / ref.bending_energy - 1) < 0.02
+
+
+NREL_COUNTS = [6, 8, 10, 12, 14, 16, 20]
+
+
+@pytest.fixture(scope="module")
+def nrel_sweep():
+    d = load_preset("NREL5MW")
+    rows = []
+    for n in NREL_COUNTS:
+        f = build_blade(d, control_points=n, adapt=False, tolerance=1.0).fairness
+        rows.append((n, f["two_part"]["mvs"], f["single"]["mvs"], f["two_part"]["strain_energy"],
+                     f["single"]["strain_energy"]))
+    print("\n NREL 5-MW  n  MVS two-part  MVS single  SE two-part  SE single")
+    for r in rows:
+        print(f"{r[0]:3d}  {r[1]:.3e}   {r[2]:.3e}  {r[3]:.1f}   {r[4]:.1f}")
+    return np.array(rows)
+
+
+def test_fig10_nrel5mw_mvs_two_part_lower_at_most_counts(nrel_sweep):
+    lower = nrel_sweep[:, 1] < nrel_sweep[:, 2]
+    assert lower.sum() >= 6 and nrel_sweep[0, 1] < 0.2 * nrel_sweep[0, 2]
+
+
+def test_fig11_nrel5mw_strain_energy_measured_outcome(nrel_sweep):
+    lower = nrel_sweep[:, 3] < nrel_sweep[:, 4]
+    assert lower[NREL_COUNTS.index(6)] and lower[NREL_COUNTS.index(8)] and lower[NREL_COUNTS.index(20)]
+    assert np.all(nrel_sweep[:, 3] / nrel_sweep[:, 4] < 1.04)
