@@ -97,6 +97,8 @@ PARALLEL_TANGENT_TOL = 1e-12
 #: Samples per knot span when measuring the true deviation between curves and extremes
 #: of curvature.
 DEVIATION_SAMPLES_PER_SPAN = 4
+#: Bracketing samples per knot span of the projections behind the true deviation.
+DEVIATION_BRACKET_SAMPLES = 4
 
 #: Weight of the kept maximum in the least-squares smoother of smoothing type 2 (relative
 #: to 1 for every other point): large enough to pin the fit to the value.
@@ -679,9 +681,13 @@ def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndar
     if not measure:
         return Deviation(same, float("nan"), float("nan"))
     us = span_samples(smoothed, DEVIATION_SAMPLES_PER_SPAN)
-    _, d1 = closest_point_curve(unsmoothed, smoothed.evaluate(us))
-    _, d2 = closest_point_curve(smoothed, unsmoothed.evaluate(span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)))
-    _, d3 = closest_point_curve(smoothed, data)
+    # the curves are close, each knot span short and gently curved: 4 bracket samples per
+    # span (the projection refines them where the curve turns) find every foot
+    k = DEVIATION_BRACKET_SAMPLES
+    _, d1 = closest_point_curve(unsmoothed, smoothed.evaluate(us), samples_per_span=k)
+    _, d2 = closest_point_curve(smoothed, unsmoothed.evaluate(span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)),
+                                samples_per_span=k)
+    _, d3 = closest_point_curve(smoothed, data, samples_per_span=k)
     t, s = arclength_table(smoothed, DEVIATION_SAMPLES_PER_SPAN)
     return Deviation(same, float(max(d1.max(), d2.max())), float(d3.max()), (s / s[-1], d1))
 
