@@ -11,9 +11,17 @@ after TE, negative thickness, a factor whose new wall the blade rulings cannot r
 leave the last good geometry and show the message, which names the field, in the panel.
 A standardised impeller also shows the largest measured distance of the trimmed blade
 edges from the new walls and the knot counts of the trimmed surfaces.
+
+The child panel "Channel walls" edits the wall angles (``[channel] hub_angle`` /
+``shroud_angle``, one per corner: "Auto" writes "auto", otherwise the angle in degrees
+from +z towards +r) and the bend fractions (``hub_fractions`` / ``shroud_fractions``,
+[f_a, f_b] placing P_1 and P_3 of each bend; drawn for bends only). The angle of an Auto
+corner shows the direction the built channel has there (:func:`corner_directions`), so
+turning Auto off starts from the current shape.
 """
 import bpy
-from bpy.props import BoolProperty, CollectionProperty, FloatProperty, PointerProperty, StringProperty
+import numpy as np
+from bpy.props import BoolProperty, CollectionProperty, FloatProperty, FloatVectorProperty, PointerProperty, StringProperty
 
 from ..operators.values import typed
 
@@ -29,6 +37,79 @@ LISTS = (
 SCALARS = ("leading_edge_hub", "leading_edge_shroud", "trailing_edge_hub", "trailing_edge_shroud")
 #: Standardisation factors: property name = key of the [standardisation] table.
 FACTORS = ("shroud_factor", "hub_factor")
+#: Channel walls: the corner-angle and bend-fraction collections are ``{wall}_angle`` and
+#: ``{wall}_fractions``, named as the [channel] keys they edit.
+WALLS = ("hub", "shroud")
+#: Channel patch degree of a bend (1 is a straight patch); see geometry/compressor/channel.py.
+BEND_DEGREE = 4
+
+
+def corner_directions(channel, degrees, wall: str) -> list:
+    """The wall direction (deg from +z towards +r, atan2(dr, dz)) of the built channel at
+    each corner of ``wall``. Next to a straight patch it is that patch's chord, computed as
+    the channel does for an "auto" corner (so the value is the one it uses, bit for bit);
+    elsewhere the polygon leg of the adjacent bend at that corner (the tangent the
+    definition's angle gives, to rounding)."""
+    string = channel.wall(wall)
+    n = string.count
+    out = []
+    for k in range(n + 1):
+        sides = [j for j in (k - 1, k) if 0 <= j < n]
+        straight = [j for j in sides if int(degrees[j]) == 1]
+        j = (straight or sides[-1:])[0]
+        P = string.segments[j].control_points
+        d = P[1] - P[0] if j == k else P[-1] - P[-2]
+        out.append(float(np.degrees(np.arctan2(d[1], d[0]))))
+    return out
+
+
+def _straight_direction(channel: dict, wall: str, k: int):
+    """The direction (deg) of a straight patch next to corner k, from the definition's
+    corners as the channel computes it (the first such patch), or None."""
+    degrees = channel["degrees"]
+    z, r = channel[f"{wall}_z"], channel[f"{wall}_r"]
+    for j in (k - 1, k):
+        if 0 <= j < len(degrees) and int(degrees[j]) == 1 and j + 1 < len(z) and j + 1 < len(r):
+            C = np.column_stack([np.asarray(z[j:j + 2], dtype=float), np.asarray(r[j:j + 2], dtype=float)])
+            chord = C[1] - C[0]
+            return float(np.degrees(np.arctan2(chord[1], chord[0])))
+    return None
+
+
+def wall_angles(settings, channel: dict, wall: str) -> list:
+    """The [channel] ``{wall}_angle`` list of the panel: "auto", or the angle as typed.
+
+    An angle next to a straight patch must equal that patch's direction to 1e-6 deg
+    (channel.ANGLE_MATCH_TOLERANCE_DEG), finer than a float32 field holds above about 16 deg; a
+    value that shows that direction (equal as float32, as after turning Auto off) is
+    written as the direction itself, so turning Auto off keeps the shape exactly."""
+    out = []
+    for k, corner in enumerate(getattr(settings, f"{wall}_angle")):
+        if corner.auto:
+            out.append("auto")
+            continue
+        value = typed(corner.angle)
+        direction = _straight_direction(channel, wall, k)
+        if direction is not None and np.float32(corner.angle) == np.float32(direction):
+            value = direction
+        out.append(value)
+    return out
+
+
+def sync_auto_angles(settings, channel, degrees) -> None:
+    """Show in each Auto corner's angle field the direction the built channel has there."""
+    was_loading = settings.loading
+    settings.loading = True
+    try:
+        for wall in WALLS:
+            corners = getattr(settings, f"{wall}_angle")
+            if len(corners) != channel.count + 1:
+                continue
+            for corner, angle in zip(corners, corner_directions(channel, degrees, wall)):
+                if corner.auto and corner.angle != np.float32(angle):
+                    corner.angle = angle
+    finally:
+        settings.loading = was_loading
 
 
 def standardisation_table(settings) -> dict:
@@ -50,6 +131,13 @@ def on_edit(self, context):
         data[section][key] = [typed(item.value) for item in getattr(settings, name)]
     for key in SCALARS:
         data["blade"][key] = typed(getattr(settings, key))
+    channel = data["channel"]
+    for wall in WALLS:
+        if len(getattr(settings, f"{wall}_angle")):  # empty in a root made before the walls were editable
+            channel[f"{wall}_angle"] = wall_angles(settings, channel, wall)
+        patches = getattr(settings, f"{wall}_fractions")
+        if len(patches):
+            channel[f"{wall}_fractions"] = [[typed(p.fractions[0]), typed(p.fractions[1])] for p in patches]
     table = standardisation_table(settings)
     if table:
         data["standardisation"] = table
@@ -58,6 +146,7 @@ def on_edit(self, context):
     try:
         model = regenerate(root, data, settings.full_wheel)
         settings.status = ""
+        sync_auto_angles(settings, model.master_channel, data["channel"]["degrees"])
         settings.standardisation_report = "" if model.standardisation is None else model.standardisation.summary()
     except BladesmithError as exc:
         settings.status = str(exc)
@@ -65,6 +154,28 @@ def on_edit(self, context):
 
 class BladesmithImpellerValue(bpy.types.PropertyGroup):
     value: FloatProperty(name="Value", update=on_edit, precision=5)
+
+
+class BladesmithImpellerCorner(bpy.types.PropertyGroup):
+    """One corner of a channel wall: its wall angle, or "auto"."""
+
+    auto: BoolProperty(
+        name="Auto", default=True, update=on_edit,
+        description="Take the direction of the adjacent straight patch (\"auto\" in the definition)")
+    angle: FloatProperty(
+        name="Angle", default=0.0, soft_min=-180.0, soft_max=180.0, step=100, precision=4, update=on_edit,
+        description="Wall direction at this corner, degrees from +z towards +r (0 axial, 90 radially outwards)")
+
+
+class BladesmithImpellerPatch(bpy.types.PropertyGroup):
+    """One patch of a channel wall: the fractions placing P_1 and P_3 of a bend."""
+
+    fractions: FloatVectorProperty(
+        name="Fractions", size=2, default=(0.5, 0.5), min=0.0, max=1.0, soft_min=0.05, soft_max=0.95,
+        step=1, precision=3, update=on_edit,
+        description="f_a, f_b: P_1 = P_0 + f_a (C - P_0) and P_3 = P_4 + f_b (C - P_4), C the meeting point of the "
+                    "corner tangents; in (0, 1), larger is a fuller bend")
+    bend: BoolProperty(name="Bend", default=False)  # degree 4; fixed by the definition
 
 
 class BladesmithImpellerSettings(bpy.types.PropertyGroup):
@@ -76,6 +187,10 @@ class BladesmithImpellerSettings(bpy.types.PropertyGroup):
     beta_shroud: CollectionProperty(type=BladesmithImpellerValue)
     thickness_hub: CollectionProperty(type=BladesmithImpellerValue)
     thickness_shroud: CollectionProperty(type=BladesmithImpellerValue)
+    hub_angle: CollectionProperty(type=BladesmithImpellerCorner)
+    shroud_angle: CollectionProperty(type=BladesmithImpellerCorner)
+    hub_fractions: CollectionProperty(type=BladesmithImpellerPatch)
+    shroud_fractions: CollectionProperty(type=BladesmithImpellerPatch)
     leading_edge_hub: FloatProperty(name="LE hub U", update=on_edit)
     leading_edge_shroud: FloatProperty(name="LE shroud U", update=on_edit)
     trailing_edge_hub: FloatProperty(name="TE hub U", update=on_edit)
@@ -109,6 +224,24 @@ class BladesmithImpellerSettings(bpy.types.PropertyGroup):
                 setattr(self, key, float(d["blade"][key]))
             for key in FACTORS:
                 setattr(self, key, float(d.get("standardisation", {}).get(key, 1.0)))
+            degrees = d["channel"]["degrees"]
+            for wall in WALLS:
+                corners = getattr(self, f"{wall}_angle")
+                corners.clear()
+                for angle in d["channel"][f"{wall}_angle"]:
+                    item = corners.add()
+                    item.auto = angle == "auto"
+                    item.angle = 0.0 if item.auto else float(angle)
+                patches = getattr(self, f"{wall}_fractions")
+                patches.clear()
+                for degree, pair in zip(degrees, d["channel"][f"{wall}_fractions"]):
+                    item = patches.add()
+                    item.fractions = (float(pair[0]), float(pair[1]))
+                    item.bend = int(degree) == BEND_DEGREE
+            try:
+                sync_auto_angles(self, definition.channel.build(definition.path), degrees)
+            except BladesmithError:
+                pass  # an invalid channel has no directions to show; the fields stay at 0
             self.full_wheel = full_wheel
             self.status = ""
             self.standardisation_report = report
@@ -151,7 +284,44 @@ class BLADESMITH_PT_impeller(bpy.types.Panel):
             box.label(text=settings.standardisation_report, icon="INFO")
 
 
-_classes = (BladesmithImpellerValue, BladesmithImpellerSettings, BLADESMITH_PT_impeller)
+class BLADESMITH_PT_impeller_walls(bpy.types.Panel):
+    """Wall angles at the corners and fractions of the bends, per wall."""
+
+    bl_label = "Channel walls"
+    bl_idname = "BLADESMITH_PT_impeller_walls"
+    bl_parent_id = "BLADESMITH_PT_impeller"
+    bl_options = {"DEFAULT_CLOSED"}
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Bladesmith"
+
+    @classmethod
+    def poll(cls, context):
+        return BLADESMITH_PT_impeller.poll(context)
+
+    def draw(self, context):
+        settings = context.active_object.bladesmith_impeller
+        for wall in WALLS:
+            box = self.layout.box()
+            box.label(text=f"{wall.capitalize()} wall")
+            col = box.column(align=True)
+            for k, corner in enumerate(getattr(settings, f"{wall}_angle")):
+                row = col.row(align=True)
+                row.label(text=f"Corner {k}")
+                row.prop(corner, "auto", toggle=True)
+                sub = row.row(align=True)
+                sub.enabled = not corner.auto
+                sub.prop(corner, "angle", text="Angle °")
+            col = box.column(align=True)
+            for j, patch in enumerate(getattr(settings, f"{wall}_fractions")):
+                if patch.bend:
+                    row = col.row(align=True)
+                    row.label(text=f"Bend {j} fractions")
+                    row.prop(patch, "fractions", text="")
+
+
+_classes = (BladesmithImpellerValue, BladesmithImpellerCorner, BladesmithImpellerPatch, BladesmithImpellerSettings,
+            BLADESMITH_PT_impeller, BLADESMITH_PT_impeller_walls)
 _register, _unregister = bpy.utils.register_classes_factory(_classes)
 
 

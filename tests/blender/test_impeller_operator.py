@@ -184,3 +184,194 @@ def test_standardised_impeller_exports_to_iges(impeller_modules, scene, tmp_path
     finally:
         gmsh.logger.stop()
         gmsh.finalize()
+
+
+# -- channel walls: corner angles and bend fractions -----------------------------------------------
+def _all_surfaces(root) -> dict:
+    """Control points of every child surface the panel regenerates (full_wheel=False)."""
+    from bladesmith.operators.nurbs_objects import object_to_geometry
+
+    out = {}
+    for child in root.children:
+        if child.type == "SURFACE":
+            (surface,) = object_to_geometry(child)
+            out[child["bladesmith_part"]] = np.array(surface.control_points)
+    return out
+
+
+def _same(a: dict, b: dict) -> bool:
+    return a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) for k in a)
+
+
+def _toml_line(root, key: str) -> str:
+    (line,) = [x for x in root["definition_toml"].splitlines() if x.startswith(f"{key} = ")]
+    return line
+
+
+def _matches_reference(root) -> bool:
+    """The children are the independent build of the stored definition, bit for bit."""
+    _, reference = _standardised_reference(root)
+    stored = _all_surfaces(root)
+    return _same(stored, {k: np.array(v.control_points) for k, v in reference.items() if k in stored})
+
+
+@pytest.mark.parametrize("preset", ["high_flow", "return_channel"])
+def test_panel_walls_load_from_the_definition(impeller_modules, scene, preset):
+    from bladesmith.geometry.compressor import ImpellerDefinition
+
+    ops, panel = impeller_modules
+    bpy.ops.bladesmith.add_impeller(preset=preset, full_wheel=False)
+    s = bpy.context.active_object.bladesmith_impeller
+    channel = ImpellerDefinition.from_toml(ops.PRESET_DIR / f"{preset}.toml").to_dict()["channel"]
+    degrees = channel["degrees"]
+    for wall in ("hub", "shroud"):
+        corners, patches = getattr(s, f"{wall}_angle"), getattr(s, f"{wall}_fractions")
+        assert len(corners) == len(degrees) + 1 and len(patches) == len(degrees)
+        z, r = np.array(channel[f"{wall}_z"]), np.array(channel[f"{wall}_r"])
+        for k, (corner, angle) in enumerate(zip(corners, channel[f"{wall}_angle"])):
+            assert corner.auto == (angle == "auto")
+            if angle == "auto":  # the direction of the adjacent straight patch, computed here independently
+                j = k - 1 if k > 0 and degrees[k - 1] == 1 else k
+                expected = np.degrees(np.arctan2(r[j + 1] - r[j], z[j + 1] - z[j]))
+            else:
+                expected = angle
+            assert corner.angle == np.float32(expected), (wall, k)
+        for patch, degree, pair in zip(patches, degrees, channel[f"{wall}_fractions"]):
+            assert patch.bend == (degree == 4)
+            assert tuple(patch.fractions) == tuple(np.float32(pair))
+    assert s.hub_angle[2].auto is False and s.hub_angle[1].auto is True
+
+
+def test_panel_wall_angle_edit_regenerates_and_restores(impeller_modules, scene):
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False)
+    root = bpy.context.active_object
+    s = root.bladesmith_impeller
+    original, toml = _all_surfaces(root), root["definition_toml"]
+    s.hub_angle[2].angle = 45.0  # a corner between the two bends
+    assert s.status == ""
+    assert _toml_line(root, "hub_angle") == 'hub_angle = ["auto", "auto", 45.0, "auto", "auto"]'
+    edited = _all_surfaces(root)
+    assert np.max(np.abs(edited["hub 1"] - original["hub 1"])) > 1e-4
+    assert np.array_equal(edited["shroud 1"], original["shroud 1"])
+    assert _matches_reference(root)
+    s.hub_angle[2].angle = 50.0
+    assert s.status == "" and root["definition_toml"] == toml and _same(_all_surfaces(root), original)
+    # Auto off at a corner next to the straight inlet, then on again: nothing moves
+    s.hub_angle[1].auto = False
+    assert s.status == "" and _toml_line(root, "hub_angle") == 'hub_angle = ["auto", 0.0, 50.0, "auto", "auto"]'
+    assert _same(_all_surfaces(root), original)
+    s.hub_angle[1].auto = True
+    assert s.status == "" and root["definition_toml"] == toml and _same(_all_surfaces(root), original)
+
+
+def test_panel_bend_fraction_edit_regenerates(impeller_modules, scene):
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False)
+    root = bpy.context.active_object
+    s = root.bladesmith_impeller
+    original = _all_surfaces(root)
+    s.hub_fractions[1].fractions[0] = 0.7
+    assert s.status == ""
+    assert _toml_line(root, "hub_fractions") == "hub_fractions = [[0.5, 0.5], [0.7, 0.5], [0.5, 0.6], [0.5, 0.5]]"
+    edited = _all_surfaces(root)
+    assert np.max(np.abs(edited["hub 1"] - original["hub 1"])) > 1e-4
+    assert np.array_equal(edited["shroud 1"], original["shroud 1"])
+    assert _matches_reference(root)
+    s.shroud_fractions[2].fractions = (0.4, 0.7)
+    assert s.status == "" and _toml_line(root, "shroud_fractions").endswith("[0.4, 0.7], [0.5, 0.5]]")
+    assert np.max(np.abs(_all_surfaces(root)["shroud 1"] - original["shroud 1"])) > 1e-4
+
+
+@pytest.mark.parametrize("item, name, value, field", [
+    ("hub_fractions", 1, (1.0, 0.5), "channel.hub_fractions"),  # outside (0, 1)
+    ("shroud_fractions", 2, (0.5, 0.0), "channel.shroud_fractions"),
+    ("hub_angle", 2, -30.0, "channel.hub_angle"),  # the corner tangents do not meet ahead of the bend
+    ("hub_angle", 2, True, "channel.hub_angle"),  # Auto between two bends: no straight patch to take it from
+    ("shroud_angle", 1, 5.0, "channel.shroud_angle"),  # does not match the straight inlet
+])
+def test_panel_refuses_bad_wall_values(impeller_modules, scene, item, name, value, field):
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False)
+    root = bpy.context.active_object
+    s = root.bladesmith_impeller
+    target = getattr(s, item)[name]
+    if item.endswith("_angle") and not isinstance(value, bool):
+        target.auto = False  # valid: the shown direction
+        assert s.status == ""
+    original, toml = _all_surfaces(root), root["definition_toml"]
+    prop = "fractions" if item.endswith("_fractions") else "auto" if isinstance(value, bool) else "angle"
+    setattr(target, prop, value)
+    assert field in s.status
+    assert root["definition_toml"] == toml and _same(_all_surfaces(root), original)  # the last good geometry
+
+
+def test_panel_auto_off_keeps_the_geometry(impeller_modules, scene):
+    """Turning Auto off writes the direction the channel used: on the presets' axial and
+    radial patches 0.0 / 90.0 as shown; on inclined straight patches the float32 field
+    cannot hold the direction to the definition's 1e-6 deg (93.57633 would be refused),
+    so the shown value is written as the direction itself and the geometry is unchanged
+    bit for bit."""
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False)
+    root = bpy.context.active_object
+    s = root.bladesmith_impeller
+    original = _all_surfaces(root)
+    for wall in ("hub", "shroud"):
+        for corner in getattr(s, f"{wall}_angle"):
+            corner.auto = False
+            assert s.status == ""
+    assert _toml_line(root, "hub_angle") == "hub_angle = [0.0, 0.0, 50.0, 90.0, 90.0]"
+    assert _same(_all_surfaces(root), original)
+    for wall in ("hub", "shroud"):
+        for k in (0, 1, 3, 4):
+            getattr(s, f"{wall}_angle")[k].auto = True
+    s.hub_r[0].value = 0.0  # the inlet hub becomes a cone at atan(0.04 / 0.06) = 33.69 deg
+    s.shroud_z[4].value = -0.025  # the diffuser shroud leans back: 93.58 deg
+    assert s.status == ""
+    assert s.hub_angle[1].angle == pytest.approx(np.degrees(np.arctan2(0.04, 0.06)), abs=1e-5)  # the shown direction follows
+    assert s.shroud_angle[3].angle == pytest.approx(np.degrees(np.arctan2(0.08, -0.005)), abs=1e-5)
+    auto = _all_surfaces(root)
+    s.hub_angle[1].auto = False
+    s.shroud_angle[3].auto = False
+    assert s.status == ""
+    assert _same(_all_surfaces(root), auto)
+    angles = __import__("tomllib").loads(root["definition_toml"])["channel"]
+    assert angles["hub_angle"][1] == pytest.approx(33.69006752598, abs=1e-9)
+    assert angles["shroud_angle"][3] == pytest.approx(93.576334375, abs=1e-8)
+    assert _matches_reference(root)
+
+
+def test_panel_walls_draws_bends_only(impeller_modules, scene):
+    from types import SimpleNamespace
+
+    panel = impeller_modules[1]
+
+    class Layout:
+        def __init__(self, parent=None, log=None):
+            self.parent, self.enabled, self.log = parent, True, log if log is not None else []
+
+        def _child(self, *args, **kwargs):
+            return Layout(self, self.log)
+
+        box = row = column = _child
+
+        def label(self, text="", icon="NONE"):
+            self.log.append(("label", text))
+
+        def prop(self, data, name, **kwargs):
+            assert name in data.bl_rna.properties, name
+            on, node = True, self
+            while node is not None:
+                on, node = on and node.enabled, node.parent
+            self.log.append(("prop", data.path_from_id(name), on))
+
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False)
+    context = SimpleNamespace(active_object=bpy.context.active_object)
+    assert panel.BLADESMITH_PT_impeller_walls.poll(context)
+    assert panel.BLADESMITH_PT_impeller_walls.bl_parent_id == panel.BLADESMITH_PT_impeller.bl_idname
+    layout = Layout()
+    panel.BLADESMITH_PT_impeller_walls.draw(SimpleNamespace(layout=layout), context)
+    props = {path: on for kind, path, *on in layout.log if kind == "prop" for on in on}
+    assert ("label", "Hub wall") in layout.log and ("label", "Shroud wall") in layout.log
+    assert props["bladesmith_impeller.hub_angle[2].angle"] is True  # explicit: editable
+    assert props["bladesmith_impeller.hub_angle[1].angle"] is False  # auto: shown, disabled
+    assert props["bladesmith_impeller.hub_angle[1].auto"] is True
+    fractions = sorted(p for p in props if p.endswith(".fractions"))
+    assert fractions == [f"bladesmith_impeller.{w}_fractions[{j}].fractions" for w in ("hub", "shroud") for j in (1, 2)]
