@@ -59,6 +59,12 @@ WALL_CHECK_SAMPLES_PER_SPAN = 8
 FOOT_MAX_ITERATIONS = 20
 FOOT_TOLERANCE = 1e-14
 
+#: The knots each trimmed surface got last time (key: name, patches, tolerance), tried
+#: first on the next trim: a live edit usually moves the edges too little to need others,
+#: and one fit replaces the knot-insertion rounds (see ``approximate_common(seed_knots)``).
+LAST_KNOTS_SIZE = 64
+_LAST_KNOTS: dict = {}
+
 #: Blade parts in the order of :func:`.export.blade_surfaces`.
 PARTS = ("S", "P", "LE", "TE")
 
@@ -114,15 +120,19 @@ def trim_surface(surface, channel: MeridionalChannel, tolerance: float, name: st
     exact = standardise(surface, channel)
     n = exact.surface.count
     report = {}
+    key = (name, n, float(tolerance))
     try:
         hub, shroud = approximate_common(
             [_remembered(exact, "hub"), _remembered(exact, "shroud")],
             tolerance, degree=3, domain=(0.0, float(n)), initial_knots=np.arange(1, INITIAL_SPANS * n) / INITIAL_SPANS,
-            report=report)
+            report=report, seed_knots=_LAST_KNOTS.get(key))
     except CutError as exc:
         raise CutError(f"{name}: {exc}" if name else str(exc), exc.wall, exc.U) from None
     except GeometryError as exc:
         raise GeometryError(f"{name}: {exc}" if name else str(exc)) from None
+    if key not in _LAST_KNOTS and len(_LAST_KNOTS) >= LAST_KNOTS_SIZE:
+        _LAST_KNOTS.pop(next(iter(_LAST_KNOTS)))
+    _LAST_KNOTS[key] = hub.knots
     P = np.stack([hub.control_points, shroud.control_points], axis=1)
     trimmed = BSplineSurface(3, 1, hub.knots, np.array([0.0, 0.0, 1.0, 1.0]), P)
     return TrimmedSurface(name, trimmed, exact, tuple(report["max_deviation"]),

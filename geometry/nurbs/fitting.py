@@ -599,6 +599,7 @@ def approximate_common(
     fit: str = "interpolate",
     max_rounds: int = DEFAULT_MAX_ROUNDS,
     report: dict | None = None,
+    seed_knots=None,
 ) -> list[BSplineCurve]:
     """Approximate several curves with ONE common knot vector (Hally 2013, §9).
 
@@ -612,6 +613,12 @@ def approximate_common(
     common vector (at most ``max_rounds`` rounds), until all curves meet ``tolerance``
     with the same knots.
 
+    ``seed_knots``: a full clamped knot vector to try first (e.g. the one found for the same
+    curves before a small edit): when every curve fitted on it meets the tolerance, by the
+    same measure as the final check below, those fits are returned (``rounds`` 0);
+    otherwise the procedure runs from ``initial_knots`` as if no seed were given, so knots
+    never accumulate from one edit to the next.
+
     Returns the curves (same degree, same knots, domain ``domain``). ``report`` receives
     ``max_deviation`` (list per curve), ``n_knots``, ``n_control``, ``rounds`` and
     ``evaluations``.
@@ -620,8 +627,20 @@ def approximate_common(
     funcs = list(funcs)
     if not funcs:
         raise GeometryError("approximate_common needs at least one curve function")
-    U = _clamped(a, _interior_knots(initial_knots, p, a, b), b, p)
     stats = {"evaluations": 0, "iterations": 0}
+    if seed_knots is not None:
+        Us = np.asarray(seed_knots, dtype=np.float64)
+        clamped = (Us.ndim == 1 and Us.size >= 2 * p + 2 and np.all(np.diff(Us) >= 0)
+                   and np.all(Us[: p + 1] == a) and np.all(Us[-p - 1:] == b))
+        if clamped:
+            results = [_fit_on_knots(f, Us, p, S, fit, None) for f in funcs]
+            stats["evaluations"] += sum(r.evaluations for r in results)
+            if all(r.max_deviation <= tol * (1.0 - DEVIATION_MARGIN) for r in results):
+                if report is not None:
+                    report.update(max_deviation=[r.max_deviation for r in results], n_knots=len(Us),
+                                  n_control=len(Us) - p - 1, rounds=0, evaluations=stats["evaluations"])
+                return [r.curve for r in results]
+    U = _clamped(a, _interior_knots(initial_knots, p, a, b), b, p)
     pending = list(range(len(funcs)))
     rounds = 0
     while True:

@@ -289,3 +289,31 @@ def test_twenty_curves_share_one_knot_vector_meeting_the_tolerance():
           f"{report['rounds']} round(s); max dense deviation {max(devs):.3e} <= tolerance {tol:g}")
     assert max(devs) <= tol
     assert _is_sub_multiset(initial, U)
+
+
+def test_approximate_common_seed_knots():
+    """A seed that still meets the tolerance is used as it is (one fit, rounds 0); one
+    that does not changes nothing: the result is the unseeded one, bit for bit."""
+    from bladesmith.geometry.nurbs.fitting import approximate_common
+
+    def curves(amplitude):
+        return [lambda t, a=amplitude: np.stack([t, a * np.sin(3 * t), np.cos(2 * t)], axis=-1),
+                lambda t, a=amplitude: np.stack([t, 0.2 + a * np.cos(3 * t), np.sin(t)], axis=-1)]
+
+    report = {}
+    first = approximate_common(curves(0.5), 1e-6, domain=(0.0, 2.0), report=report)
+    assert report["rounds"] >= 1
+    seed = first[0].knots
+    # a small edit: the old knots still hold the tolerance
+    rep = {}
+    edited = approximate_common(curves(0.501), 1e-6, domain=(0.0, 2.0), report=rep, seed_knots=seed)
+    assert rep["rounds"] == 0 and np.array_equal(edited[0].knots, seed)
+    assert max(rep["max_deviation"]) <= 1e-6
+    # a seed too coarse for the tolerance: the usual procedure, unchanged
+    coarse = np.array([0, 0, 0, 0, 1.0, 2, 2, 2, 2])
+    a = approximate_common(curves(0.5), 1e-6, domain=(0.0, 2.0), seed_knots=coarse)
+    for x, y in zip(a, first):
+        assert np.array_equal(x.knots, y.knots) and np.array_equal(x.control_points, y.control_points)
+    # a seed that is not a clamped vector on the domain is ignored
+    b = approximate_common(curves(0.5), 1e-6, domain=(0.0, 2.0), seed_knots=seed * 2)
+    assert np.array_equal(b[0].control_points, first[0].control_points)
