@@ -318,8 +318,8 @@ def test_blunt_trailing_edge_whose_tangents_do_not_meet_is_extended_gently():
     from bladesmith.geometry.fairing import hvid
 
     x = 0.5 * (1 - np.cos(np.linspace(0.0, np.pi, 60)))
-    for slope in (0.0, -0.02):  # parallel, then diverging towards the trailing edge
-        thick = 0.12 * np.sqrt(x) * (1 - x) + 0.004 * x + slope * np.maximum(x - 0.9, 0) ** 2 / 0.2
+    for flare in (0.0, 0.5):  # parallel end tangents, then diverging (a flared trailing edge)
+        thick = 0.12 * np.sqrt(x) * (1 - x) ** 2 + 0.002 + flare * np.maximum(x - 0.9, 0) ** 2
         upper = np.column_stack([x, thick])
         lower = np.column_stack([x, -thick])
         outline = np.concatenate([upper[::-1], lower[1:]])
@@ -328,7 +328,7 @@ def test_blunt_trailing_edge_whose_tangents_do_not_meet_is_extended_gently():
         assert np.allclose(ext[0], ext[-1])  # one apex: a sharp trailing edge to smooth
         gap = float(np.linalg.norm(outline[0] - outline[-1]))
         L = np.clip(hvid.TE_EXTENSION_GAPS * gap, hvid.MIN_TE_EXTENSION, hvid.MAX_TE_FALLBACK)
-        assert ext[0, 0] == pytest.approx(1.0 + L, rel=0.05)
+        assert ext[0, 0] == pytest.approx(1.0 + L, rel=2e-3)  # the fallback, not a far intersection
         # the first extension step leaves the trailing edge along the end tangent
         spline, _ = hvid.spline_through(outline, 2)
         t_end = spline.derivatives(spline.domain[1], 1)[1]
@@ -336,4 +336,6 @@ def test_blunt_trailing_edge_whose_tangents_do_not_meet_is_extended_gently():
         cos = step @ t_end / np.linalg.norm(step) / np.linalg.norm(t_end)
         assert cos > np.cos(np.radians(1.0))
         r = hvid.smoothfoil(outline)
-        assert r.converged and np.linalg.norm(r.points[0] - r.points[-1]) == pytest.approx(gap, rel=0.05)
+        assert r.converged
+        # the trailing edge stays blunt, its thickness changed by at most twice the deviation
+        assert abs(np.linalg.norm(r.points[0] - r.points[-1]) - gap) <= 2.0 * r.deviation.true
