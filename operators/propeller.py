@@ -607,7 +607,7 @@ def store_status(settings, result: DisplayResult, seconds: float) -> None:
     else:
         settings.display_deviation = -1.0
         detail = smoothing_summary(result.smoothing)
-    deviation = getattr(result.model.blade.section, "smoothing_deviation", None)
+    deviation = result.model.blade.section.smoothing_deviation
     if deviation is not None:
         detail += f"; airfoil smoothed (Hvid), deviation {deviation:.2e} chord"
     settings.status = f"{detail}; {seconds * 1e3:.0f} ms"

@@ -41,7 +41,7 @@ import numpy as np
 
 from ..errors import BladesmithError, DefinitionError
 from ..sections.airfoil_file import Airfoil, read_airfoil, smoothed_airfoil
-from ..sections.shape import DEFAULT_SMOOTH_PASSES, MAX_SMOOTH_PASSES
+from ..sections.shape import DEFAULT_SMOOTH_PASSES, check_smooth_passes
 
 #: Points per half of the built-in "circle" section (cosine spaced, dense at the ends).
 CIRCLE_POINTS = 101
@@ -213,10 +213,7 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
     smooth = data.get("smooth_airfoils", False)
     if not isinstance(smooth, bool):
         raise DefinitionError(f"expected true or false, got {smooth!r}", path=path, field="smooth_airfoils")
-    passes = data.get("smooth_passes", DEFAULT_SMOOTH_PASSES)
-    if isinstance(passes, bool) or not isinstance(passes, int) or not 1 <= passes <= MAX_SMOOTH_PASSES:
-        raise DefinitionError(f"expected a whole number of passes from 1 to {MAX_SMOOTH_PASSES}, got {passes!r}",
-                              path=path, field="smooth_passes")
+    passes = check_smooth_passes(data.get("smooth_passes", DEFAULT_SMOOTH_PASSES), path, "smooth_passes")
     if smooth:
         stations = _smoothed_stations(stations, first, path, passes)
     return BladeDefinition(name, hub, tuple(stations), d / np.linalg.norm(d), wrap, first, n, tol, path, smooth,

@@ -628,35 +628,34 @@ def approximate_common(
     if not funcs:
         raise GeometryError("approximate_common needs at least one curve function")
     stats = {"evaluations": 0, "iterations": 0}
+    limit = tol * (1.0 - DEVIATION_MARGIN)
+    results, rounds = None, 0
     if seed_knots is not None:
         Us = np.asarray(seed_knots, dtype=np.float64)
         clamped = (Us.ndim == 1 and Us.size >= 2 * p + 2 and np.all(np.diff(Us) >= 0)
                    and np.all(Us[: p + 1] == a) and np.all(Us[-p - 1:] == b))
         if clamped:
-            results = [_fit_on_knots(f, Us, p, S, fit, None) for f in funcs]
+            seeded = [_fit_on_knots(f, Us, p, S, fit, None) for f in funcs]
+            stats["evaluations"] += sum(r.evaluations for r in seeded)
+            if all(r.max_deviation <= limit for r in seeded):
+                results, U = seeded, Us
+    if results is None:
+        U = _clamped(a, _interior_knots(initial_knots, p, a, b), b, p)
+        pending = list(range(len(funcs)))
+        while True:
+            rounds += 1
+            for i in pending:
+                U = _approximate_from(funcs[i], U, p, tol, a, b, max_knots, S, fit, None, stats).curve.knots
+            results = [_fit_on_knots(f, U, p, S, fit, None) for f in funcs]
             stats["evaluations"] += sum(r.evaluations for r in results)
-            if all(r.max_deviation <= tol * (1.0 - DEVIATION_MARGIN) for r in results):
-                if report is not None:
-                    report.update(max_deviation=[r.max_deviation for r in results], n_knots=len(Us),
-                                  n_control=len(Us) - p - 1, rounds=0, evaluations=stats["evaluations"])
-                return [r.curve for r in results]
-    U = _clamped(a, _interior_knots(initial_knots, p, a, b), b, p)
-    pending = list(range(len(funcs)))
-    rounds = 0
-    while True:
-        rounds += 1
-        for i in pending:
-            U = _approximate_from(funcs[i], U, p, tol, a, b, max_knots, S, fit, None, stats).curve.knots
-        results = [_fit_on_knots(f, U, p, S, fit, None) for f in funcs]
-        stats["evaluations"] += sum(r.evaluations for r in results)
-        pending = [i for i, r in enumerate(results) if r.max_deviation > tol * (1.0 - DEVIATION_MARGIN)]
-        if not pending:
-            break
-        if rounds >= max_rounds:
-            raise GeometryError(
-                f"no common knot vector met the tolerance {tol:.3g} within {max_rounds} rounds "
-                f"(curves {pending} still fail)"
-            )
+            pending = [i for i, r in enumerate(results) if r.max_deviation > limit]
+            if not pending:
+                break
+            if rounds >= max_rounds:
+                raise GeometryError(
+                    f"no common knot vector met the tolerance {tol:.3g} within {max_rounds} rounds "
+                    f"(curves {pending} still fail)"
+                )
     if report is not None:
         report.update(
             max_deviation=[r.max_deviation for r in results],

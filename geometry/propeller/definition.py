@@ -54,7 +54,7 @@ import numpy as np
 
 from ..files import atomic_write
 from ..errors import DefinitionError
-from ..sections.shape import DEFAULT_SMOOTH_PASSES, MAX_SMOOTH_PASSES
+from ..sections.shape import DEFAULT_SMOOTH_PASSES, check_smooth_passes
 
 RADIAL_FIELDS = ("r_R", "c_D", "P_D", "skew_deg", "rake_D", "t_c", "f_c")
 CSV_ALIASES = {"t0_c": "t_c", "f0_c": "f_c"}
@@ -257,10 +257,7 @@ class Propeller:
         if not isinstance(s.smooth_airfoil, bool):
             raise DefinitionError(f"expected true or false, got {_fmt(s.smooth_airfoil)}", path=p,
                                   field="section.smooth_airfoil")
-        if isinstance(s.smooth_passes, bool) or not isinstance(s.smooth_passes, int) \
-                or not 1 <= s.smooth_passes <= MAX_SMOOTH_PASSES:
-            raise DefinitionError(f"expected a whole number of passes from 1 to {MAX_SMOOTH_PASSES}, got "
-                                  f"{_fmt(s.smooth_passes)}", path=p, field="section.smooth_passes")
+        check_smooth_passes(s.smooth_passes, p, "section.smooth_passes")
         if s.smooth_airfoil and s.thickness in _THICKNESS_FORMS:
             raise DefinitionError(
                 f"smooth_airfoil = true needs an airfoil .dat file as thickness (it smooths the file's outline, "

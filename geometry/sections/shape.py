@@ -110,6 +110,15 @@ DEFAULT_SMOOTH_PASSES = 4
 MAX_SMOOTH_PASSES = 50
 
 
+def check_smooth_passes(value, path, field: str) -> int:
+    """A definition's ``smooth_passes``: a whole number from 1 to :data:`MAX_SMOOTH_PASSES`,
+    else a DefinitionError naming ``path``, ``field`` and the value."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_SMOOTH_PASSES:
+        raise DefinitionError(f"expected a whole number of passes from 1 to {MAX_SMOOTH_PASSES}, got {value!r}",
+                              path=path, field=field)
+    return int(value)
+
+
 def _smoothed(airfoil: Airfoil, source=None, passes: int = DEFAULT_SMOOTH_PASSES) -> Airfoil:
     """``airfoil`` smoothed by Hvid's smoothfoil (``passes`` passes of the ad hoc
     smoother); a failure names the airfoil file."""

@@ -142,14 +142,19 @@ def test_fig8_equal_totals_crossover(sweep):
 
 @pytest.fixture(scope="module")
 def blade_sweep():
-    d = load_preset("S823_SMALL")
+    return _fairness_sweep("S823_SMALL", BLADE_COUNTS)
+
+
+def _fairness_sweep(preset: str, counts) -> np.ndarray:
+    """Rows (n, MVS two-part, MVS single, SE two-part, SE single) of the blade ``preset``,
+    fitted with n control points per half (no adaptation)."""
+    d = load_preset(preset)
     rows = []
-    for n in BLADE_COUNTS:
-        m = build_blade(d, control_points=n, adapt=False, tolerance=1.0)
-        f = m.fairness
+    for n in counts:
+        f = build_blade(d, control_points=n, adapt=False, tolerance=1.0).fairness
         rows.append((n, f["two_part"]["mvs"], f["single"]["mvs"], f["two_part"]["strain_energy"],
                      f["single"]["strain_energy"]))
-    print("\n  n  MVS two-part  MVS single  SE two-part  SE single")
+    print(f"\n {preset}  n  MVS two-part  MVS single  SE two-part  SE single")
     for r in rows:
         print(f"{r[0]:3d}  {r[1]:.3e}   {r[2]:.3e}  {r[3]:.1f}   {r[4]:.1f}")
     return np.array(rows)
@@ -216,16 +221,7 @@ NREL_COUNTS = [6, 8, 10, 12, 14, 16, 20]
 
 @pytest.fixture(scope="module")
 def nrel_sweep():
-    d = load_preset("NREL5MW")
-    rows = []
-    for n in NREL_COUNTS:
-        f = build_blade(d, control_points=n, adapt=False, tolerance=1.0).fairness
-        rows.append((n, f["two_part"]["mvs"], f["single"]["mvs"], f["two_part"]["strain_energy"],
-                     f["single"]["strain_energy"]))
-    print("\n NREL 5-MW  n  MVS two-part  MVS single  SE two-part  SE single")
-    for r in rows:
-        print(f"{r[0]:3d}  {r[1]:.3e}   {r[2]:.3e}  {r[3]:.1f}   {r[4]:.1f}")
-    return np.array(rows)
+    return _fairness_sweep("NREL5MW", NREL_COUNTS)
 
 
 def test_fig10_nrel5mw_mvs_two_part_lower_at_most_counts(nrel_sweep):
