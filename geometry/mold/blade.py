@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import BladesmithError, GeometryError
-from ..nurbs import BSplineSurface, interpolate, skin
+from ..nurbs import BSplineCurve, BSplineSurface, interpolate, skin
 from ..nurbs.fitting import approximation_knots, parameterize
 from ..nurbs.projection import closest_point_curve
 from ..nurbs.skinning import skin_parameters
@@ -100,9 +100,8 @@ class BladeMolds:
         if self.transition_upper is not None:
             pairs.append(("transition_trailing_edge", self.transition_upper, self.transition_lower))
         for name, up, lo in pairs:
-            base = trailing_edge_surface(up, lo)
-            if base is not None:
-                out[name] = base
+            for j, base in enumerate(trailing_edge_surfaces(up, lo)):
+                out[name if j == 0 else f"{name}_{j + 1}"] = base
         return out
 
 
@@ -191,6 +190,9 @@ def root_transition(root_nets, aero: BSplineSurface, w, scale: float, degree_w: 
     D = scale * aero.degree_v / (V[aero.degree_v + 1] - V[0]) * (P[:, 1] - P[:, 0])
     cols = [interpolate(root_nets[:, i], q, params=w, end_derivative=D[i]) for i in range(root_nets.shape[1])]
     net = np.stack([c.control_points for c in cols], axis=0)
+    # the end rows are the root section and the first airfoil (shared with the aero surface):
+    # the banded solve with the derivative row reproduces them only to rounding
+    net[:, 0], net[:, -1] = root_nets[0], P[:, 0]
     return BSplineSurface(aero.degree_u, q, aero.knots_u, cols[0].knots, net)
 
 
@@ -198,14 +200,153 @@ def root_transition(root_nets, aero: BSplineSurface, w, scale: float, degree_w: 
 #: edge: the trailing edge is sharp and needs no base surface.
 SHARP_TE_TOL = 1e-12
 
+#: Control points of the trailing-edge thickness spline shorter than this (relative to the
+#: blade size) are the rounding of a zero thickness: they are set to exactly zero, so the
+#: halves of a sharp trailing edge share their edge bit for bit.
+TE_ZERO_TOL = 1e-12
 
-def trailing_edge_surface(upper: BSplineSurface, lower: BSplineSurface) -> BSplineSurface | None:
-    """The ruled base of a blunt trailing edge between lower(1, v) and upper(0, v) (both
-    halves share v knots), or None when the edges coincide (sharp TE, C0 join)."""
+
+def trailing_edge_thickness_spline(params, thickness, degree: int, end_derivative=None) -> BSplineCurve:
+    """The trailing-edge thickness vector T(v) = upper TE - lower TE between the stations,
+    as a B-spline of ``degree`` that keeps the sign of its data: the shape-preserving C1
+    cubic Hermite interpolant (Fritsch & Carlson 1980; the derivatives of
+    ``scipy.interpolate.PchipInterpolator``, per component) written in Bezier form on the
+    station parameters (knots of multiplicity 2) and degree-elevated to ``degree``
+    (NURBS Book Alg. A5.9); piecewise linear when ``degree`` < 3.
+
+    Why: the skinning of Hosseini §5 (NURBS Book §10.3) interpolates every column of
+    control points with one C2 spline, a global interpolant. Where the thickness jumps
+    from a blunt airfoil to a sharp one (NREL 5-MW: 12.6 mm at r = 40.45 m, 0 from
+    44.55 m) it rings, and between the sharp stations the two halves cross. The Hermite
+    interpolant stays, in each component, within the range of its two neighbouring station
+    values: exactly zero between two sharp stations, never of the other sign between blunt
+    ones. ``end_derivative``: T'(params[-1]) when given (the root transition meets the
+    aerodynamic surface G1 along its trailing edge too).
+    """
+    from scipy.interpolate import PchipInterpolator
+
+    from ..nurbs.operations import elevate_degree
+
+    v = np.asarray(params, dtype=np.float64)
+    d = np.asarray(thickness, dtype=np.float64)
+    if degree < 3:
+        curve = BSplineCurve(1, np.concatenate([[v[0]], v, [v[-1]]]), d)
+        return elevate_degree(curve, degree - 1) if degree > 1 else curve
+    m = PchipInterpolator(v, d, axis=0).derivative()(v)
+    if end_derivative is not None:
+        m[-1] = end_derivative
+    h = np.diff(v)[:, None]
+    inner = np.empty((2 * (len(v) - 1), d.shape[1]))
+    inner[0::2] = d[:-1] + h * m[:-1] / 3.0  # second Bezier point of each segment
+    inner[1::2] = d[1:] - h * m[1:] / 3.0  # third
+    cps = np.vstack([d[:1], inner, d[-1:]])
+    knots = np.concatenate([[v[0]] * 4, np.repeat(v[1:-1], 2), [v[-1]] * 4])
+    return elevate_degree(BSplineCurve(3, knots, cps), degree - 3) if degree > 3 else BSplineCurve(3, knots, cps)
+
+
+def _missing_knots(have: np.ndarray, want: np.ndarray) -> list[float]:
+    """The knots of ``want`` not in ``have``, counted with multiplicity (sorted)."""
+    out = []
+    for value in np.unique(want):
+        out += [float(value)] * max(0, int(np.count_nonzero(want == value)) - int(np.count_nonzero(have == value)))
+    return out
+
+
+def shape_preserving_trailing_edge(upper: BSplineSurface, lower: BSplineSurface, params, thickness,
+                                   end_derivative=None) -> tuple[BSplineSurface, BSplineSurface]:
+    """The skinned halves with a trailing edge that never folds (issue 19, item 1).
+
+    ``thickness``: (K, 3) upper TE point - lower TE point at the K stations (parameters
+    ``params``). T(v) of :func:`trailing_edge_thickness_spline` and the two halves are
+    brought onto one knot vector by knot insertion (NURBS Book Alg. A5.4; nothing moves):
+    the halves gain the station parameters as double knots, T gains the skinning knots.
+    The lower half's TE column becomes the upper half's minus T's control points. Every
+    other column keeps its C2 skinning curve, and the lower TE edge still passes through
+    the station points; only it is C1 (not C2) at the stations. Thickness control points
+    below :data:`TE_ZERO_TOL` × size are set to zero, so a sharp stretch is one edge.
+    A blade sharp at every station is returned unchanged.
+    """
+    from ..nurbs.operations import refine_knots, refine_knots_surface
+
+    d = np.asarray(thickness, dtype=np.float64)
+    size = max(upper.size(), lower.size())
+    if np.all(np.linalg.norm(d, axis=1) <= SHARP_TE_TOL * size):
+        return upper, lower
+    T = trailing_edge_thickness_spline(params, d, upper.degree_v, end_derivative)
+    to_surface = _missing_knots(upper.knots_v, T.knots)
+    to_thickness = _missing_knots(T.knots, upper.knots_v)
+    up = refine_knots_surface(upper, "v", to_surface) if to_surface else upper
+    lo = refine_knots_surface(lower, "v", to_surface) if to_surface else lower
+    T = refine_knots(T, to_thickness) if to_thickness else T
+    if T.knots.shape != up.knots_v.shape or np.any(T.knots != up.knots_v):
+        raise GeometryError("the trailing-edge thickness spline and the mold halves ended on different knots")
+    coeffs = np.array(T.control_points)
+    coeffs[np.linalg.norm(coeffs, axis=1) <= TE_ZERO_TOL * size] = 0.0
+    # the end rows are the first and last sections (shared with the root transition and
+    # the caps): knot insertion reproduces them only to rounding, so copy them back
+    Pu = up.control_points.copy()
+    Pu[:, 0], Pu[:, -1] = upper.control_points[:, 0], upper.control_points[:, -1]
+    P = lo.control_points.copy()
+    P[-1] = Pu[0] - coeffs
+    P[:, 0], P[:, -1] = lower.control_points[:, 0], lower.control_points[:, -1]
+    P[0] = Pu[-1]  # the LE parting line: one array for both halves
+    return (BSplineSurface(up.degree_u, up.degree_v, up.knots_u, up.knots_v, Pu),
+            BSplineSurface(lo.degree_u, lo.degree_v, lo.knots_u, up.knots_v, P))
+
+
+def trailing_edge_pieces(upper: BSplineSurface, lower: BSplineSurface) -> list[tuple[float, float]]:
+    """The v intervals where the trailing edge is blunt (its two edges apart): maximal runs
+    of knot spans whose thickness control points are not all zero."""
+    diff = np.linalg.norm(upper.control_points[0] - lower.control_points[-1], axis=1)
+    tol = SHARP_TE_TOL * upper.size()
+    W, q = upper.knots_v, upper.degree_v
+    pieces = []
+    for s in range(q, len(W) - q - 1):
+        if W[s + 1] <= W[s]:
+            continue
+        blunt = bool(np.any(diff[s - q: s + 1] > tol))
+        if blunt and pieces and pieces[-1][1] == W[s]:
+            pieces[-1] = (pieces[-1][0], float(W[s + 1]))
+        elif blunt:
+            pieces.append((float(W[s]), float(W[s + 1])))
+    return pieces
+
+
+def trailing_edge_surfaces(upper: BSplineSurface, lower: BSplineSurface) -> list[BSplineSurface]:
+    """The ruled bases of a blunt trailing edge between lower(1, v) and upper(0, v) (both
+    halves share v knots; degree 1 across), one per blunt stretch of the span; none where
+    the edges coincide (sharp TE, the halves join C0 along one edge)."""
+    from ..nurbs.operations import split_surface
+
     a, b = lower.control_points[-1], upper.control_points[0]
     if np.linalg.norm(a - b, axis=1).max() <= SHARP_TE_TOL * upper.size():
-        return None
-    return BSplineSurface(1, upper.degree_v, np.array([0.0, 0.0, 1.0, 1.0]), upper.knots_v, np.stack([a, b]))
+        return []
+    ruled = BSplineSurface(1, upper.degree_v, np.array([0.0, 0.0, 1.0, 1.0]), upper.knots_v, np.stack([a, b]))
+    v0, v1 = upper.knots_v[0], upper.knots_v[-1]
+    out = []
+    for lo_v, hi_v in trailing_edge_pieces(upper, lower):
+        piece = ruled
+        if hi_v < v1:
+            piece = split_surface(piece, "v", hi_v)[0]
+        if lo_v > v0:
+            piece = split_surface(piece, "v", lo_v)[1]
+        out.append(piece)
+    return out
+
+
+def trailing_edge_surface(upper: BSplineSurface, lower: BSplineSurface) -> BSplineSurface | None:
+    """The first ruled base of :func:`trailing_edge_surfaces`, or None (sharp TE)."""
+    pieces = trailing_edge_surfaces(upper, lower)
+    return pieces[0] if pieces else None
+
+
+def _te_start_derivative(upper: BSplineSurface, lower: BSplineSurface, scale: float) -> np.ndarray:
+    """scale · d/dv (upper TE - lower TE) at v = 0: the clamped end derivative
+    q / (v_{q+1} - v_0) (P_1 - P_0) of both TE columns."""
+    V, q = upper.knots_v, upper.degree_v
+    du = upper.control_points[0, 1] - upper.control_points[0, 0]
+    dl = lower.control_points[-1, 1] - lower.control_points[-1, 0]
+    return scale * q / (V[q + 1] - V[0]) * (du - dl)
 
 
 def _angle_deg(a, b) -> np.ndarray:
@@ -303,6 +444,8 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
     v = section_parameters([nets_u[k0:], nets_l[k0:]])
     upper = skin([fits[k].upper for k in aero], degree_v, params=v)
     lower = skin([fits[k].lower for k in aero], degree_v, params=v)
+    te = nets_u[:, 0] - nets_l[:, -1]  # (K, 3) trailing-edge thickness vectors of the stations
+    upper, lower = shape_preserving_trailing_edge(upper, lower, v, te[k0:])
     tr_u = tr_l = None
     if k0 > 0:
         w = section_parameters([nets_u[: k0 + 1], nets_l[: k0 + 1]])
@@ -310,6 +453,9 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
         scale = span(0, k0) / span(k0, len(fits) - 1)
         tr_u = root_transition(nets_u[: k0 + 1], upper, w, scale, degree_v)
         tr_l = root_transition(nets_l[: k0 + 1], lower, w, scale, degree_v)
+        # T_w(1) of the transition = scale · T_v(0) of the aero halves (G1 at the joint)
+        tr_u, tr_l = shape_preserving_trailing_edge(tr_u, tr_l, w, te[: k0 + 1],
+                                                    end_derivative=_te_start_derivative(upper, lower, scale))
     times["skinning"] = time.perf_counter() - t0
     tick(0.65)
 
