@@ -37,6 +37,7 @@ from .sections import (
     SECTION_DEGREE,
     SplitSection,
     TwoPartFit,
+    aligned_parameters,
     default_knots,
     fit_single,
     fit_two_part,
@@ -87,6 +88,10 @@ class BladeMolds:
     fairness: dict = field(default_factory=dict)
     continuity: dict = field(default_factory=dict)
     times: dict = field(default_factory=dict)
+    #: The fits used :func:`.sections.aligned_parameters` (the plain chord-length ones failed).
+    aligned_parameters: bool = False
+    #: Per station: the tolerance (chord fraction) it was fitted to.
+    tolerances: np.ndarray | None = None
 
     @property
     def surfaces(self) -> dict:
@@ -134,24 +139,43 @@ def common_knots(point_sets, n_control: int, degree: int = SECTION_DEGREE) -> np
     return np.mean([default_knots(P, n_control, degree) for P in point_sets], axis=0)
 
 
-def _fit_all(splits, aero, n, degree, defn):
+class StationFitError(GeometryError):
+    """A section that cannot be fitted on the common knots: ``station`` is its index."""
+
+    def __init__(self, message: str, station: int):
+        super().__init__(message)
+        self.station = station
+
+
+def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None):
+    """Every section on the common knots (Hosseini §3) with G1 at S (§4): free SQP fits of
+    the aero sections give the ratio ρ, then all are refitted with λ_u = ρ λ_l. align:
+    parameters of :func:`.sections.aligned_parameters`. magnitudes: (λ_u, λ_l) by hand."""
     Ku = common_knots([splits[k].upper for k in aero], n, degree)
     Kl = common_knots([splits[k].lower for k in aero], n, degree)
+
+    def params(k):
+        if not align:
+            return {}
+        return {"params_upper": aligned_parameters(splits[k].upper, Ku, degree),
+                "params_lower": aligned_parameters(splits[k].lower, Kl, degree)}
+
+    def fit(k, **kw):
+        try:
+            return fit_two_part(splits[k], Ku, Kl, degree=degree, **params(k), **kw)
+        except BladesmithError as exc:
+            st = defn.stations[k]
+            raise StationFitError(f"station {k} (r = {st.r:g} m, airfoil {st.airfoil_name or st.airfoil.name!r}): "
+                                  f"{exc}", k) from None
+
+    if magnitudes is not None:
+        return [fit(k, magnitudes=magnitudes) for k in range(len(splits))], magnitudes[0] / magnitudes[1]
     ratios = []
     for k in aero:
-        try:
-            f = fit_two_part(splits[k], Ku, Kl, degree=degree)
-        except BladesmithError as exc:
-            raise _station_error(k, defn.stations[k], exc) from None
+        f = fit(k)
         ratios.append(f.magnitude_upper / f.magnitude_lower)
     rho = float(np.exp(np.mean(np.log(ratios))))
-    fits = []
-    for k, sp in enumerate(splits):
-        try:
-            fits.append(fit_two_part(sp, Ku, Kl, degree=degree, ratio=rho))
-        except BladesmithError as exc:
-            raise _station_error(k, defn.stations[k], exc) from None
-    return fits, rho
+    return [fit(k, ratio=rho) for k in range(len(splits))], rho
 
 
 def section_deviation(split: SplitSection, fit: TwoPartFit) -> float:
@@ -379,17 +403,132 @@ def joint_continuity(transition: BSplineSurface, aero: BSplineSurface) -> tuple[
     return float(gap), float(ang)
 
 
+def _deviations(splits, fits, chords, tols) -> np.ndarray:
+    """Per station: the largest distance of its points to its fitted halves / chord.
+    |Q_r - C(t_r)| bounds the closest-point distance from above; the latter is measured
+    only where the bound misses the tolerance, worst bound first, and no further once one
+    station really misses it (the others keep their bounds: the attempt fails anyway)."""
+    worst = np.array([f.max_residual for f in fits]) / chords
+    for k in np.argsort(-(worst / tols)):
+        if worst[k] <= tols[k]:
+            break
+        worst[k] = section_deviation(splits[k], fits[k])
+        if worst[k] > tols[k]:
+            break
+    return worst
+
+
+def _why(defn: BladeDefinition, k: int) -> str:
+    """What makes station k hard, from its neighbours (for the refusal message)."""
+    st = defn.stations
+    notes = []
+    for j in (k - 1, k + 1):
+        if 0 <= j < len(st):
+            ratio = max(st[j].chord, st[k].chord) / min(st[j].chord, st[k].chord)
+            circle = (st[j].airfoil_name == "circle") != (st[k].airfoil_name == "circle")
+            if ratio >= 2.0 or circle:
+                notes.append(f"station {j} has chord {st[j].chord:g} m ({ratio:.2g}x)"
+                             + (", one of the two is the root circle" if circle else ""))
+    if k < defn.first_aerodynamic_station:
+        notes.append("it lies in the root transition (structural zone), fitted on the aerodynamic zone's knots")
+    te = st[k].airfoil.trailing_edge_thickness
+    if te > 0.02:
+        notes.append(f"its trailing edge is {te:.3g} chord thick")
+    return "; ".join(notes)
+
+
+def _no_fit_message(defn: BladeDefinition, attempts: list, tols: np.ndarray) -> str:
+    """Which station, why, and the nearest setting that builds (issue 19, item 2)."""
+    measured = [a for a in attempts if a[2] is not None]
+    if measured:
+        n, align, worst, _ = min(measured, key=lambda a: float(np.max(a[2] / tols)))
+        k = int(np.argmax(worst / tols))
+        st = defn.stations[k]
+        why = _why(defn, k)
+        reach = float(np.max(worst / tols))
+        msg = (f"station {k} (r = {st.r:g} m, airfoil {st.airfoil_name or st.airfoil.name!r}) cannot be fitted within "
+               f"its tolerance {tols[k]:g} chord: the best fit ({n} control points per half"
+               f"{', aligned parameters' if align else ''}) deviates {worst[k]:.3g} chord")
+        if why:
+            msg += f" ({why})"
+        fixes = [f"tolerance = {float(np.max(worst)) * 1.01:.2g} (or this station's tolerance {worst[k] * 1.01:.2g}) "
+                 f"with control_points = {n}"]
+        if k == defn.first_aerodynamic_station and k + 1 < len(defn.stations) - 1:
+            fixes.append(f"first_aerodynamic_station = {k + 1} (station {k} in the root transition)")
+        return msg + "; nearest setting that builds: " + " or ".join(fixes) + f" (worst/tolerance {reach:.3g})"
+    n, align, _, exc = attempts[-1]
+    k = getattr(exc, "station", None)
+    fixes = f"control_points = {max(MIN_SECTION_CONTROL_POINTS, n - 2 * CONTROL_POINT_STEP)}"
+    if k is not None and k + 1 < len(defn.stations) - 1:
+        fixes += f" or first_aerodynamic_station = {k + 1}"
+    return f"no fit with {n} control points per half: {exc}; nearest setting to try: {fixes}"
+
+
+#: The fewest control points per half a section fit is tried with.
+MIN_SECTION_CONTROL_POINTS = 5
+
+
+#: The largest raise of the control-point count between two attempts.
+MAX_CONTROL_POINT_JUMP = 4 * CONTROL_POINT_STEP
+
+
+def _next_step(n: int, attempts: list) -> int:
+    """How many control points to add after a failed count n: the least-squares error of
+    a cubic fit to smooth data falls about as n^-4 (Hosseini Fig. 5), so the count that
+    meets the tolerance is about n (worst / tolerance)^(1/4); a multiple of
+    :data:`CONTROL_POINT_STEP`, between one and :data:`MAX_CONTROL_POINT_JUMP`."""
+    ratios = [float(np.max(a[2] / a[3])) for a in attempts if a[0] == n and a[2] is not None]
+    if not ratios:
+        return CONTROL_POINT_STEP
+    want = n * min(ratios) ** 0.25 - n
+    steps = int(np.ceil(max(want, 1.0) / CONTROL_POINT_STEP))
+    return int(min(MAX_CONTROL_POINT_JUMP, steps * CONTROL_POINT_STEP))
+
+
+def fit_sections(defn: BladeDefinition, splits, n: int, tols: np.ndarray, degree: int = SECTION_DEGREE,
+                 adapt: bool = True, magnitudes=None):
+    """The section fits on common knots, the control-point count raised by
+    :data:`CONTROL_POINT_STEP` (with ``adapt``) until every station k lies within
+    ``tols[k]`` × chord. At each count the paper's chord-length parameters are tried
+    first, then :func:`.sections.aligned_parameters`. Returns (fits, ρ, n, aligned,
+    attempts); raises GeometryError naming the station, the cause and the nearest setting
+    that builds (:func:`_no_fit_message`). attempts: (n, aligned, deviations, tolerances)
+    of every measured try, (n, aligned, None, error) of a try whose fit failed."""
+    aero = list(range(defn.first_aerodynamic_station, len(defn.stations)))
+    chords = np.array([s.chord for s in defn.stations])
+    attempts = []
+    while True:
+        for align in (False, True):
+            try:
+                fits, rho = _fit_all(splits, aero, n, degree, defn, align, magnitudes)
+            except StationFitError as exc:
+                attempts.append((n, align, None, exc))
+                continue
+            worst = _deviations(splits, fits, chords, tols)
+            attempts.append((n, align, worst, tols))
+            if np.all(worst <= tols):
+                return fits, rho, n, align, attempts
+        if not adapt or n >= MAX_CONTROL_POINTS:
+            raise GeometryError(_no_fit_message(defn, attempts, tols))
+        n = min(MAX_CONTROL_POINTS, n + _next_step(n, attempts))
+
+
 def build_blade(defn: BladeDefinition, control_points: int | None = None, tolerance: float | None = None,
-                degree: int = SECTION_DEGREE, degree_v: int = 3, single: bool = True, fairness: bool = True,
-                adapt: bool = True, quadrature_points: int | None = None, progress=None) -> BladeMolds:
+                degree: int | None = None, degree_v: int | None = None, single: bool = True, fairness: bool = True,
+                adapt: bool = True, quadrature_points: int | None = None, progress=None,
+                tangent_magnitudes=None) -> BladeMolds:
     """Mold halves of the blade ``defn`` (Hosseini & Moetakef-Imani 2016).
 
     control_points: per half and section (default the definition's); with ``adapt`` it is
-    raised by :data:`CONTROL_POINT_STEP` until every section's data lie within
-    ``tolerance`` × chord (default the definition's, 1e-4) of its fitted curve, at most
-    :data:`MAX_CONTROL_POINTS`. single: also build the traditional single surface (with
-    2n - 1 control points per section, the two halves' count with S shared). fairness: MVS
-    and strain energy (Eq. 6) of the aero surfaces. progress: callable(fraction) or None.
+    raised by :data:`CONTROL_POINT_STEP` until every section's data lie within its
+    tolerance × chord (``tolerance``, default the definition's per-station tolerances or
+    its one tolerance, 1e-4) of its fitted curve, at most :data:`MAX_CONTROL_POINTS`
+    (see :func:`fit_sections`). degree / degree_v: p of the section curves and q across
+    the sections (default the definition's, 3 and 3). tangent_magnitudes: (λ_u, λ_l) of
+    the derivative at S by hand (Hosseini Fig. 7a), default the definition's, or None for
+    SQP. single: also build the traditional single surface (with 2n - 1 control points
+    per section, the two halves' count with S shared). fairness: MVS and strain energy
+    (Eq. 6) of the aero surfaces. progress: callable(fraction) or None.
     Returns :class:`BladeMolds`; ``times`` holds the stage times in seconds.
     """
     from ..fairing.surface_fairness import surface_fairness
@@ -401,40 +540,25 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
     times = {}
     t0 = time.perf_counter()
     n = int(control_points or defn.control_points)
-    tol = float(tolerance or defn.tolerance)
+    degree = int(degree or getattr(defn, "section_degree", SECTION_DEGREE))
+    degree_v = int(degree_v or getattr(defn, "span_degree", 3))
+    if tangent_magnitudes is None:
+        tangent_magnitudes = getattr(defn, "tangent_magnitudes", None)
     k0 = defn.first_aerodynamic_station
     aero = list(range(k0, len(defn.stations)))
     if len(aero) < 2:
         raise GeometryError(f"the aerodynamic zone needs at least 2 stations, got {len(aero)}")
+    if tolerance:
+        tols = np.full(len(defn.stations), float(tolerance))
+    else:
+        per = getattr(defn, "station_tolerances", None)
+        tols = np.array(per, dtype=np.float64) if per is not None else np.full(len(defn.stations), defn.tolerance)
     splits = blade_sections(defn, degree)
     times["sections"] = time.perf_counter() - t0
     tick(0.15)
 
     t0 = time.perf_counter()
-    chords = np.array([s.chord for s in defn.stations])
-    while True:
-        try:
-            fits, rho = _fit_all(splits, aero, n, degree, defn)
-            # |Q_r - C(t_r)| bounds the closest-point distance from above; measure the
-            # latter only where the bound fails
-            worst = np.array([f.max_residual for f in fits]) / chords
-            for k in np.flatnonzero(worst > tol):
-                worst[k] = section_deviation(splits[k], fits[k])
-            ok = bool(np.all(worst <= tol))
-        except BladesmithError:
-            if n == int(control_points or defn.control_points):
-                raise
-            ok, fits = False, None
-        if ok or not adapt or n + CONTROL_POINT_STEP > MAX_CONTROL_POINTS:
-            if fits is None:
-                raise GeometryError(f"no fit with {n} control points per half")
-            break
-        n += CONTROL_POINT_STEP
-    if not ok:
-        k = int(np.argmax(worst))
-        raise GeometryError(
-            f"station {k} (r = {defn.stations[k].r:g} m): the fit deviates {worst[k]:.3g} chord from its points "
-            f"with {n} control points per half, more than the tolerance {tol:g}")
+    fits, rho, n, aligned, attempts = fit_sections(defn, splits, n, tols, degree, adapt, tangent_magnitudes)
     times["section_fits"] = time.perf_counter() - t0
     tick(0.5)
 
@@ -465,7 +589,10 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
     if single:
         Ks = np.mean([approximation_knots(parameterize(splits[k].points), 2 * n - 1, degree) for k in aero], axis=0)
         for k in aero:
-            single_fits[k] = fit_single(splits[k].points, Ks, degree=degree)
+            try:
+                single_fits[k] = fit_single(splits[k].points, Ks, degree=degree, align=aligned)
+            except BladesmithError:  # the single curve's knot spans differ from the halves'
+                single_fits[k] = fit_single(splits[k].points, Ks, degree=degree, align=not aligned)
         curves = [single_fits[k].curve for k in aero]
         v_single = skin_parameters(curves)
         single_surface = skin(curves, degree_v, params=v_single)
@@ -527,5 +654,5 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
     times["fairness"] = time.perf_counter() - t0
     tick(1.0)
     return BladeMolds(defn, upper, lower, single_surface, tr_u, tr_l, parting, reports, n, rho, v, fair,
-                      continuity, times)
+                      continuity, times, aligned, tols)
 

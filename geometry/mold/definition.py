@@ -88,6 +88,11 @@ def resolve_airfoil(spec: str, base: pathlib.Path | None) -> Airfoil:
     """An airfoil from a station's ``airfoil`` entry: "circle", a shipped name, or a path."""
     if spec == "circle":
         return circle_airfoil()
+    head = spec.partition("#")[0]
+    if "#" in spec and head.lower().endswith((".yaml", ".yml")):
+        from .windio import airfoil_from_spec  # windio imports this module
+
+        return airfoil_from_spec(spec, base)
     shipped = shipped_airfoils()
     if spec in shipped:
         return read_airfoil(shipped[spec])
@@ -260,8 +265,13 @@ def _smoothed_stations(stations: list, first: int, path, passes: int = DEFAULT_S
 
 
 def load_blade(path) -> BladeDefinition:
-    """Read and validate a blade definition TOML file."""
+    """Read and validate a blade definition: a TOML file, or a windIO turbine file
+    (``.yaml`` / ``.yml``, :mod:`.windio`) through the same checks."""
     path = pathlib.Path(path)
+    if path.suffix.lower() in (".yaml", ".yml"):
+        from .windio import load_windio_blade
+
+        return load_windio_blade(path)
     try:
         with open(path, "rb") as f:
             data = tomllib.load(f)

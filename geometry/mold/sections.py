@@ -185,9 +185,9 @@ class _AffineHalf:
     enters the right-hand side linearly), so the residual is r(λ) = r0 + λ g and two fits
     give the objective Σ|Q_r - C(t_r)|² (Hosseini Eq. 3) exactly as a quadratic in λ."""
 
-    def __init__(self, points, knots, degree, tangent, at_start: bool):
+    def __init__(self, points, knots, degree, tangent, at_start: bool, params=None):
         self.points = points
-        self.params = parameterize(points)
+        self.params = parameterize(points) if params is None else np.asarray(params, dtype=np.float64)
         self.knots = knots
         self.degree = degree
         self.tangent = tangent
@@ -240,8 +240,28 @@ def default_knots(points, n_control: int, degree: int = SECTION_DEGREE) -> np.nd
     return approximation_knots(parameterize(points), n_control, degree)
 
 
+def aligned_parameters(points, knots, degree: int = SECTION_DEGREE) -> np.ndarray:
+    """Chord-length parameters of ``points`` mapped onto the knot vector ``knots``.
+
+    The section's own approximation knots (NURBS Book Eqs. 9.68–9.69, as many as
+    ``knots``) are sent onto ``knots`` by the piecewise-linear map through corresponding
+    knots, and every parameter with them. Each knot span of ``knots`` then holds the data
+    its own knot span held: Schoenberg–Whitney holds and the fit is as good as the
+    section's own. Hosseini §3 averages the knot vectors and refits on the average; for
+    sections of very different shape (a thick blunt root airfoil and a thin tip one, a
+    circle and an airfoil) the plain chord-length parameters can leave a common knot span
+    empty or nearly so. Used by :func:`~.blade.build_blade` when the plain fit fails."""
+    t = parameterize(points)
+    K = np.asarray(knots, dtype=np.float64)
+    own = approximation_knots(t, len(K) - degree - 1, degree)
+    a, b = own[degree: len(own) - degree], K[degree: len(K) - degree]
+    keep = np.concatenate([[True], np.diff(a) > 0])
+    return np.interp(t, a[keep], b[keep])
+
+
 def fit_two_part(split: SplitSection, knots_upper=None, knots_lower=None, n_control: int = 12,
-                 degree: int = SECTION_DEGREE, ratio: float | None = None) -> TwoPartFit:
+                 degree: int = SECTION_DEGREE, ratio: float | None = None, params_upper=None,
+                 params_lower=None, magnitudes=None) -> TwoPartFit:
     """Two constrained least-squares fits with G1 at S and the tangent magnitudes by SQP.
 
     knots_upper / knots_lower: the knot vectors of the halves (e.g. the blade's common ones,
@@ -251,11 +271,19 @@ def fit_two_part(split: SplitSection, knots_upper=None, knots_lower=None, n_cont
     :data:`MIN_MAGNITUDE_FRACTION` of the preliminary fit's. ``ratio``: if given, the
     equality constraint λ_u = ratio · λ_l, which a blade needs so that the halves' cross
     derivatives stay parallel between its stations (G1 along the whole parting line).
+    params_upper / params_lower: the halves' data parameters (default chord length; see
+    :func:`aligned_parameters`). magnitudes: (λ_u, λ_l) set by hand instead of by SQP
+    (the tangent magnitude at S of Hosseini Fig. 7a, in units of the halves' parameters).
     """
     Ku = default_knots(split.upper, n_control, degree) if knots_upper is None else np.asarray(knots_upper)
     Kl = default_knots(split.lower, n_control, degree) if knots_lower is None else np.asarray(knots_lower)
-    up = _AffineHalf(split.upper, Ku, degree, split.tangent, at_start=False)
-    lo = _AffineHalf(split.lower, Kl, degree, split.tangent, at_start=True)
+    up = _AffineHalf(split.upper, Ku, degree, split.tangent, at_start=False, params=params_upper)
+    lo = _AffineHalf(split.lower, Kl, degree, split.tangent, at_start=True, params=params_lower)
+    if magnitudes is not None:
+        lam_u, lam_l = (float(x) for x in magnitudes)
+        if not (lam_u > 0 and lam_l > 0 and np.isfinite(lam_u) and np.isfinite(lam_l)):
+            raise GeometryError(f"the tangent magnitudes at S must be positive and finite, got {magnitudes!r}")
+        return _finish(up, lo, split, lam_u, lam_l, 0)
     scale = np.array([split.magnitude_upper, split.magnitude_lower])
     norm = split.chord**2
 
@@ -275,12 +303,17 @@ def fit_two_part(split: SplitSection, knots_upper=None, knots_lower=None, n_cont
                       bounds=[(MIN_MAGNITUDE_FRACTION, None)] * 2, constraints=constraints,
                       options={"ftol": SLSQP_FTOL, "maxiter": 200})
     lam_u, lam_l = result.x * scale
+    return _finish(up, lo, split, float(lam_u), float(lam_l), int(result.nit))
+
+
+def _finish(up: _AffineHalf, lo: _AffineHalf, split: SplitSection, lam_u: float, lam_l: float,
+            iterations: int) -> TwoPartFit:
     cu, cl = up._fit(lam_u), lo._fit(lam_l)
     ru = _residual(cu, split.upper[:-1], up.params[:-1])
     rl = _residual(cl, split.lower[1:], lo.params[1:])
     err = float(np.sum(ru**2) + np.sum(rl**2))
     mx = float(max(np.linalg.norm(ru, axis=1).max(), np.linalg.norm(rl, axis=1).max()))
-    return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, int(result.nit))
+    return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, iterations)
 
 
 @dataclass(frozen=True, eq=False)
@@ -292,12 +325,16 @@ class SingleFit:
     max_residual: float
 
 
-def fit_single(points, knots=None, n_control: int = 23, degree: int = SECTION_DEGREE) -> SingleFit:
+def fit_single(points, knots=None, n_control: int = 23, degree: int = SECTION_DEGREE,
+               align: bool = False) -> SingleFit:
     """Least-squares fit of the whole section, ends interpolated (NURBS Book §9.4.1), on
-    ``knots`` or the approximation knots for ``n_control`` (Eqs. 9.68–9.69)."""
+    ``knots`` or the approximation knots for ``n_control`` (Eqs. 9.68–9.69); ``align``:
+    the parameters of :func:`aligned_parameters`."""
     Q = np.asarray(points, dtype=np.float64)
     t = parameterize(Q)
     K = approximation_knots(t, n_control, degree) if knots is None else np.asarray(knots)
+    if align:
+        t = aligned_parameters(Q, K, degree)
     c = fit_least_squares(Q, len(K) - degree - 1, degree, params=t, knots=K)
     r = _residual(c, Q, t)
     return SingleFit(c, float(np.sum(r**2)), float(np.linalg.norm(r, axis=1).max()))
