@@ -150,7 +150,8 @@ class StationFitError(GeometryError):
 def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None):
     """Every section on the common knots (Hosseini §3) with G1 at S (§4): free SQP fits of
     the aero sections give the ratio ρ, then all are refitted with λ_u = ρ λ_l. align:
-    parameters of :func:`.sections.aligned_parameters`. magnitudes: (λ_u, λ_l) by hand."""
+    parameters of :func:`.sections.aligned_parameters`. magnitudes: (λ_u, λ_l) by hand, in
+    chords (each station's derivative at S is λ × its chord)."""
     Ku = common_knots([splits[k].upper for k in aero], n, degree)
     Kl = common_knots([splits[k].lower for k in aero], n, degree)
 
@@ -168,8 +169,10 @@ def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None
             raise StationFitError(f"station {k} (r = {st.r:g} m, airfoil {st.airfoil_name or st.airfoil.name!r}): "
                                   f"{exc}", k) from None
 
-    if magnitudes is not None:
-        return [fit(k, magnitudes=magnitudes) for k in range(len(splits))], magnitudes[0] / magnitudes[1]
+    if magnitudes is not None:  # by hand, in chords: one ratio for every station (G1 along the LE)
+        fits = [fit(k, magnitudes=(magnitudes[0] * splits[k].chord, magnitudes[1] * splits[k].chord))
+                for k in range(len(splits))]
+        return fits, magnitudes[0] / magnitudes[1]
     ratios = []
     for k in aero:
         f = fit(k)
@@ -656,3 +659,62 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
     return BladeMolds(defn, upper, lower, single_surface, tr_u, tr_l, parting, reports, n, rho, v, fair,
                       continuity, times, aligned, tols)
 
+
+
+# ---------------------------------------------------------------------------------------
+# the control-point sweep (the x-axis of Hosseini Figs. 5, 8, 10 and 11)
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SweepRow:
+    """One count of :func:`control_point_sweep`: n control points per half (2n - 1
+    distinct per section, S shared), the single surface with the same 2n - 1. LSQ: Eq. 3
+    summed over the aerodynamic stations (m²); MVS and strain energy: Eq. 6 of the aero
+    surfaces (both halves summed); worst: the largest station deviation / chord."""
+
+    n: int
+    lsq_two_part: float
+    lsq_single: float
+    mvs_two_part: float
+    mvs_single: float
+    strain_energy_two_part: float
+    strain_energy_single: float
+    worst_deviation: float
+
+
+def control_point_sweep(defn: BladeDefinition, counts, quadrature_points: int | None = None,
+                        progress=None) -> list[SweepRow]:
+    """Build the blade at each control-point count of ``counts`` (no raising to meet the
+    tolerance) and tabulate the least-squares errors and the fairness of the two-part and
+    the single approach at equal total control points (Hosseini Figs. 5, 8, 10, 11)."""
+    counts = [int(c) for c in counts]
+    if not counts or any(c < MIN_SECTION_CONTROL_POINTS or c > MAX_CONTROL_POINTS for c in counts):
+        raise GeometryError(f"sweep counts must lie in [{MIN_SECTION_CONTROL_POINTS}, {MAX_CONTROL_POINTS}], "
+                            f"got {counts}")
+    rows = []
+    for i, n in enumerate(counts):
+        m = build_blade(defn, control_points=n, tolerance=float("inf"), adapt=False, single=True, fairness=True,
+                        quadrature_points=quadrature_points)
+        aero = [r for r in m.stations if r.index >= defn.first_aerodynamic_station]
+        f = m.fairness
+        rows.append(SweepRow(n, float(sum(r.lsq_two_part for r in aero)), float(sum(r.lsq_single for r in aero)),
+                             f["two_part"]["mvs"], f["single"]["mvs"], f["two_part"]["strain_energy"],
+                             f["single"]["strain_energy"], float(max(r.deviation_two_part for r in m.stations))))
+        if progress is not None:
+            progress((i + 1) / len(counts))
+    return rows
+
+
+def format_sweep(rows, markdown: bool = True) -> str:
+    """The sweep as a table (Markdown by default)."""
+    head = ["n per half", "LSQ two-part (m²)", "LSQ single (m²)", "MVS two-part", "MVS single",
+            "strain energy two-part", "strain energy single", "worst section (chord)"]
+    lines = []
+    if markdown:
+        lines.append("| " + " | ".join(head) + " |")
+        lines.append("|" + "---:|" * len(head))
+    for r in rows:
+        cells = [f"{r.n}", f"{r.lsq_two_part:.3e}", f"{r.lsq_single:.3e}", f"{r.mvs_two_part:.3e}",
+                 f"{r.mvs_single:.3e}", f"{r.strain_energy_two_part:.1f}", f"{r.strain_energy_single:.1f}",
+                 f"{r.worst_deviation:.2e}"]
+        lines.append("| " + " | ".join(cells) + " |" if markdown else "  ".join(cells))
+    return "\n".join(lines)

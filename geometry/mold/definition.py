@@ -60,8 +60,29 @@ BLADES_DIR = DATA_DIR / "blades"
 SMOOTHED_CACHE_SIZE = 16
 _SMOOTHED: dict = {}
 
+#: Degrees of the section curves (p) and across the sections (q): the defaults, and the
+#: accepted ranges (p >= 2: the fit prescribes an end derivative at S).
+DEFAULT_SECTION_DEGREE = 3
+DEFAULT_SPAN_DEGREE = 3
+SECTION_DEGREES = (2, 5)
+SPAN_DEGREES = (1, 5)
+
+# ---------------------------------------------------------------------------------------
+# Every key a wind-blade definition may hold: the one place a strict-key check reads
+# (issue 20). Top level, and the arrays of [stations].
+# ---------------------------------------------------------------------------------------
 REQUIRED = ("r", "chord", "twist_deg", "pitch_axis", "airfoil")
-OPTIONAL = ("prebend", "sweep")
+#: "tolerance": per station, a chord fraction overriding the top-level one (issue 19).
+OPTIONAL = ("prebend", "sweep", "tolerance")
+STATION_KEYS = REQUIRED + OPTIONAL
+TOP_LEVEL_KEYS = (
+    "name", "hub_radius", "mold_direction", "wrap", "first_aerodynamic_station", "control_points", "tolerance",
+    "smooth_airfoils", "smooth_passes", "stations",
+    # issue 19: the paper's controls
+    "section_degree",     # p of the section curves (Hosseini Eq. 1), 2..5, default 3
+    "span_degree",        # q across the sections (Eq. 4), 1..5, default 3
+    "tangent_magnitude",  # "sqp" (default: optimised, §4 Fig. 7b) or [upper, lower] by hand (Fig. 7a)
+)
 
 
 def circle_airfoil() -> Airfoil:
@@ -131,6 +152,14 @@ class BladeDefinition:
     smooth_airfoils: bool = False
     #: ...with this many passes of the ad hoc curvature smoother (the paper's jobcard: 4).
     smooth_passes: int = DEFAULT_SMOOTH_PASSES
+    #: p of the section curves and q across the sections (Hosseini Eqs. 1 and 4).
+    section_degree: int = DEFAULT_SECTION_DEGREE
+    span_degree: int = DEFAULT_SPAN_DEGREE
+    #: (λ_upper, λ_lower): the tangent magnitudes at S by hand (Hosseini Fig. 7a), or None
+    #: for SQP (§4).
+    tangent_magnitudes: tuple | None = None
+    #: Per station: the tolerance (chord fraction), or None for ``tolerance`` everywhere.
+    station_tolerances: tuple | None = None
 
     def to_dict(self) -> dict:
         """The definition as TOML-ready values (airfoils by name or path)."""
@@ -140,10 +169,13 @@ class BladeDefinition:
             "wrap": self.wrap, "first_aerodynamic_station": self.first_aerodynamic_station,
             "control_points": self.control_points, "tolerance": self.tolerance,
             "smooth_airfoils": self.smooth_airfoils, "smooth_passes": self.smooth_passes,
+            "section_degree": self.section_degree, "span_degree": self.span_degree,
+            "tangent_magnitude": "sqp" if self.tangent_magnitudes is None else list(self.tangent_magnitudes),
             "stations": {
                 "r": [s.r for s in st], "chord": [s.chord for s in st], "twist_deg": [s.twist_deg for s in st],
                 "pitch_axis": [s.pitch_axis for s in st], "prebend": [s.prebend for s in st],
                 "sweep": [s.sweep for s in st], "airfoil": [s.airfoil_name for s in st],
+                **({} if self.station_tolerances is None else {"tolerance": list(self.station_tolerances)}),
             },
         }
 
@@ -175,7 +207,7 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
     stations = []
     for k in range(count):
         vals = {key: _number(st[key][k], path, f"stations.{key}[{k}]") for key in REQUIRED[:-1]}
-        extra = {key: _number(st[key][k], path, f"stations.{key}[{k}]") for key in OPTIONAL if key in st}
+        extra = {key: _number(st[key][k], path, f"stations.{key}[{k}]") for key in ("prebend", "sweep") if key in st}
         if k and vals["r"] <= stations[-1].r:
             raise DefinitionError(
                 f"station {k}: r = {vals['r']!r} m does not increase (station {k - 1} has r = {stations[-1].r!r} m)",
@@ -219,10 +251,43 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
     if not isinstance(smooth, bool):
         raise DefinitionError(f"expected true or false, got {smooth!r}", path=path, field="smooth_airfoils")
     passes = check_smooth_passes(data.get("smooth_passes", DEFAULT_SMOOTH_PASSES), path, "smooth_passes")
+    p = _degree(data.get("section_degree", DEFAULT_SECTION_DEGREE), SECTION_DEGREES, path, "section_degree")
+    q = _degree(data.get("span_degree", DEFAULT_SPAN_DEGREE), SPAN_DEGREES, path, "span_degree")
+    if q > count - first - 1:
+        raise DefinitionError(f"span_degree {q} needs at least {q + 1} aerodynamic stations, the blade has "
+                              f"{count - first}", path=path, field="span_degree")
+    magnitudes = _tangent_magnitudes(data.get("tangent_magnitude", "sqp"), path)
+    station_tols = None
+    if "tolerance" in st:
+        station_tols = tuple(_number(v, path, f"stations.tolerance[{k}]") for k, v in enumerate(st["tolerance"]))
+        for k, v in enumerate(station_tols):
+            if v <= 0:
+                raise DefinitionError(f"station {k}: expected a positive chord fraction, got {v!r}", path=path,
+                                      field=f"stations.tolerance[{k}]")
     if smooth:
         stations = _smoothed_stations(stations, first, path, passes)
     return BladeDefinition(name, hub, tuple(stations), d / np.linalg.norm(d), wrap, first, n, tol, path, smooth,
-                           passes)
+                           passes, p, q, magnitudes, station_tols)
+
+
+def _degree(value, bounds, path, fld) -> int:
+    lo, hi = bounds
+    if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+        raise DefinitionError(f"expected an integer in [{lo}, {hi}], got {value!r}", path=path, field=fld)
+    return value
+
+
+def _tangent_magnitudes(value, path) -> tuple | None:
+    """"sqp" (None) or [λ_upper, λ_lower] > 0: the derivative magnitudes at S (Hosseini
+    Fig. 7a), in units of each half's [0, 1] parameter per chord (the halves' lengths)."""
+    if isinstance(value, str) and value.lower() == "sqp":
+        return None
+    if isinstance(value, list) and len(value) == 2:
+        lam = tuple(_number(v, path, "tangent_magnitude") for v in value)
+        if all(x > 0 for x in lam):
+            return lam
+    raise DefinitionError(f'expected "sqp" or [upper, lower] (two positive numbers), got {value!r}', path=path,
+                          field="tangent_magnitude")
 
 
 def _smoothed_airfoil(foil: Airfoil, passes: int) -> Airfoil:

@@ -98,9 +98,9 @@ def windio_version(doc: dict) -> int:
     return int(major)
 
 
-def _get(tree, keys: str, path: str):
+def _get(tree, keys: str, path: str, prefix: str = ""):
     node = tree
-    done = []
+    done = [prefix] if prefix else []
     for k in keys.split("."):
         done.append(k)
         if not isinstance(node, dict) or k not in node:
@@ -140,28 +140,28 @@ def _blade_fields(doc: dict, path: str) -> dict:
     version = windio_version(doc)
     blade = _get(doc, "components.blade", path)
     if version == 1:
-        shape = _get(blade, "outer_shape_bem", path)
+        shape = _get(blade, "outer_shape_bem", path, "components.blade")
         base = "components.blade.outer_shape_bem"
-        pos = _get(shape, "airfoil_position", path)
+        pos = _get(shape, "airfoil_position", path, base)
         grid, labels = pos.get("grid"), pos.get("labels")
-        twist = _distribution(_get(shape, "twist", path), path, f"{base}.twist")
+        twist = _distribution(_get(shape, "twist", path, base), path, f"{base}.twist")
         twist = (twist[0], np.degrees(twist[1]))
-        pitch = ("fraction", _distribution(_get(shape, "pitch_axis", path), path, f"{base}.pitch_axis"))
-        axis = _get(shape, "reference_axis", path)
+        pitch = ("fraction", _distribution(_get(shape, "pitch_axis", path, base), path, f"{base}.pitch_axis"))
+        axis = _get(shape, "reference_axis", path, base)
         axis_field = f"{base}.reference_axis"
     else:
-        shape = _get(blade, "outer_shape", path)
+        shape = _get(blade, "outer_shape", path, "components.blade")
         base = "components.blade.outer_shape"
-        foils = _get(shape, "airfoils", path)
+        foils = _get(shape, "airfoils", path, base)
         if not isinstance(foils, list):
             raise DefinitionError("expected a list", path=path, field=f"{base}.airfoils")
         grid = [f.get("spanwise_position") if isinstance(f, dict) else None for f in foils]
         labels = [f.get("name") if isinstance(f, dict) else None for f in foils]
-        twist = _distribution(_get(shape, "twist", path), path, f"{base}.twist")
-        pitch = ("offset", _distribution(_get(shape, "section_offset_y", path), path, f"{base}.section_offset_y"))
-        axis = _get(blade, "reference_axis", path)
+        twist = _distribution(_get(shape, "twist", path, base), path, f"{base}.twist")
+        pitch = ("offset", _distribution(_get(shape, "section_offset_y", path, base), path, f"{base}.section_offset_y"))
+        axis = _get(blade, "reference_axis", path, "components.blade")
         axis_field = "components.blade.reference_axis"
-    chord = _distribution(_get(shape, "chord", path), path, f"{base}.chord")
+    chord = _distribution(_get(shape, "chord", path, base), path, f"{base}.chord")
     if not isinstance(grid, list) or not isinstance(labels, list) or len(grid) != len(labels) or len(grid) < 2:
         raise DefinitionError("expected the airfoil positions and names as lists of one length >= 2", path=path,
                               field=f"{base}.{'airfoil_position' if version == 1 else 'airfoils'}")
@@ -175,7 +175,7 @@ def _blade_fields(doc: dict, path: str) -> dict:
     for k, name in enumerate(labels):
         if not isinstance(name, str) or not name:
             raise DefinitionError(f"airfoil {k}: expected a name, got {name!r}", path=path, field=f"{base} airfoil names")
-    axes = {a: _distribution(_get(axis, a, path), path, f"{axis_field}.{a}") for a in "xyz"}
+    axes = {a: _distribution(_get(axis, a, path, axis_field), path, f"{axis_field}.{a}") for a in "xyz"}
     hub = doc.get("components", {}).get("hub", {})
     diameter = hub.get("diameter", hub.get("outer_shape_bem", {}).get("diameter") if isinstance(hub, dict) else None) \
         if isinstance(hub, dict) else None

@@ -293,6 +293,8 @@ class _Reader:
                 i += 1
             elif i < len(s) and s[i] == "]":
                 return out, i + 1
+            elif i >= len(s):
+                self.fail(line, "a flow sequence '[' that does not close on its line")
             else:
                 self.fail(line, f"expected ',' or ']' in a flow sequence at column {i + 1}")
 
@@ -318,6 +320,8 @@ class _Reader:
                 i += 1
             elif i < len(s) and s[i] == "}":
                 return out, i + 1
+            elif i >= len(s):
+                self.fail(line, "a flow mapping '{' that does not close on its line")
             else:
                 self.fail(line, f"expected ',' or '}}' in a flow mapping at column {i + 1}")
 

@@ -18,11 +18,12 @@ Figs. 5 / 7b / 8 (section)::
 
 - Fig. 5: the two-part error falls at every step of the sweep.
 - Fig. 7b: the optimised magnitudes vary with n (0.78 -> 1.10 -> 1.07 upper).
-- Fig. 8: with the same count per curve (single curve n, each half n) the two-part error
-  is lower at every n. With the same total of distinct control points (single 2n - 1,
-  S shared) it is lower only from n = 10 (10, 14-20; n = 12 is within 2 %): at low counts
-  the fixed tangent at S costs more than the split gains. The paper's "lower at every
-  count" therefore holds for the per-curve count, not for equal totals.
+- Fig. 8 (test_fig8_at_equal_total_control_points): with the same total of distinct
+  control points (single 2n - 1, S shared) the two-part error is lower only from n = 10
+  (10, 14-20; n = 12 is within 2 %): at low counts the fixed tangent at S costs more than
+  the split gains. With the same count per curve (single curve n, each half n; the
+  separate test_fig8_per_curve_reading_...) it is lower at every n. The paper's "lower
+  at every count" therefore holds for the per-curve count, not for equal totals.
 
 Figs. 10-11 (the S823 small blade, data/blades/s823_small.toml, aero zone: two-part =
 upper + lower, single = one surface with 2n - 1 control points per section)::
@@ -131,13 +132,19 @@ def test_fig7b_optimised_magnitude_varies_with_count(sweep):
         assert np.ptp(sweep[:, col]) > 0.2 * np.mean(sweep[:, col])
 
 
-def test_fig8_two_part_below_single_at_every_count(sweep):
-    assert np.all(sweep[:, 1] < sweep[:, 2])
-
-
-def test_fig8_equal_totals_crossover(sweep):
+def test_fig8_at_equal_total_control_points(sweep):
+    """Fig. 8 as the paper's figure must be read: both fits with the same 2n - 1 distinct
+    control points (S shared by the halves). The two-part fit is lower from n = 14 and at
+    n = 10, higher at n = 5-8: the paper's "lower at every count" does not hold here."""
     lower = sweep[:, 1] < sweep[:, 3]
     assert not lower[0] and lower[COUNTS.index(10)] and np.all(lower[COUNTS.index(14):])
+
+
+def test_fig8_per_curve_reading_two_part_below_single_with_n_each(sweep):
+    """The per-curve reading (each half n, the single curve n: the two-part fit has about
+    twice the control points): lower at every count. Kept apart from the equal-total test
+    because it compares unequal totals."""
+    assert np.all(sweep[:, 1] < sweep[:, 2])
 
 
 @pytest.fixture(scope="module")
