@@ -50,6 +50,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, St
 
 from ..geometry.errors import BladesmithError, DefinitionError
 from ..geometry.mold import BladeDefinition, BladeMolds, blade_from_dict, build_blade, load_blade, preset_files
+from ..geometry.mold.definition import save_blade
 from ..iges.mold import write_molds
 from ..geometry.nurbs import BSplineCurve
 from ..geometry.propeller import dumps_toml
@@ -145,9 +146,16 @@ def settings_to_dict(settings) -> dict:
         "tolerance": typed(settings.tolerance),
         "smooth_airfoils": bool(settings.smooth_airfoils),
         "smooth_passes": int(settings.smooth_passes),
+        "section_degree": int(settings.section_degree),
+        "span_degree": int(settings.span_degree),
+        "tangent_magnitude": ("sqp" if settings.tangent_mode == "SQP"
+                              else [typed(settings.tangent_upper), typed(settings.tangent_lower)]),
         "stations": {
             **{name: [typed(getattr(row, name)) for row in rows] for name in STATION_FIELDS},
             "airfoil": [row.airfoil.strip() for row in rows],
+            # a row's tolerance 0 means the blade's; any row set gives the per-station array
+            **({"tolerance": [typed(row.tolerance) or typed(settings.tolerance) for row in rows]}
+               if any(row.tolerance > 0 for row in rows) else {}),
         },
     }
 
@@ -171,6 +179,11 @@ def definition_to_settings(settings, defn: BladeDefinition, base_dir: str = "") 
         settings.tolerance = defn.tolerance
         settings.smooth_airfoils = defn.smooth_airfoils
         settings.smooth_passes = defn.smooth_passes
+        settings.section_degree = defn.section_degree
+        settings.span_degree = defn.span_degree
+        settings.tangent_mode = "SQP" if defn.tangent_magnitudes is None else "HAND"
+        if defn.tangent_magnitudes is not None:
+            settings.tangent_upper, settings.tangent_lower = defn.tangent_magnitudes
         settings.base_dir = base_dir
         settings.source_path = defn.path
         settings.stations.clear()
@@ -179,6 +192,8 @@ def definition_to_settings(settings, defn: BladeDefinition, base_dir: str = "") 
             for name in STATION_FIELDS:
                 setattr(row, name, getattr(st, name))
             row.airfoil = st.airfoil_name
+        for row, tol in zip(settings.stations, defn.station_tolerances or ()):
+            row.tolerance = tol
         settings.stations_index = min(max(settings.stations_index, 0), len(settings.stations) - 1)
         settings.fitted_control_points = 0
 
@@ -267,10 +282,13 @@ def store_results(settings, molds: BladeMolds, seconds: float) -> None:
             settings.strain_energy_two_part = fair["two_part"]["strain_energy"]
             settings.strain_energy_single = fair["single"]["strain_energy"]
         settings.regeneration_time = seconds
+        settings.fitted_ratio = float(molds.ratio)
+        settings.aligned_parameters = bool(molds.aligned_parameters)
         smoothed = [st.airfoil.smoothing_deviation for st in defn.stations if st.airfoil.smoothing_deviation is not None]
         note = f"; airfoils smoothed (Hvid), worst deviation {max(smoothed):.2e} chord" if smoothed else ""
+        aligned = "; aligned parameters (the chord-length ones missed)" if molds.aligned_parameters else ""
         settings.status = (f"{molds.control_points} control points per half, worst section "
-                           f"{settings.max_deviation:.2e} chord{note}; {seconds * 1e3:.0f} ms")
+                           f"{settings.max_deviation:.2e} chord{note}{aligned}; {seconds * 1e3:.0f} ms")
         settings.status_is_error = False
 
 
@@ -287,7 +305,7 @@ def regenerate(root, *, fresh: bool = False, fairness: bool | None = None, progr
         n = defn.control_points
         if not fresh and settings.fitted_control_points > n:
             n = settings.fitted_control_points
-        molds = compute_molds(defn, control_points=n, tolerance=defn.tolerance,
+        molds = compute_molds(defn, control_points=n, tolerance=0.0,
                               fairness=settings.live_fairness if fairness is None else fairness, progress=progress)
     except BladesmithError as exc:
         with suspended_updates():
@@ -372,7 +390,8 @@ class BLADESMITH_OT_add_wind_blade(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     definition: StringProperty(
-        name="Definition", description="Blade definition file (.toml); when empty, the preset is used",
+        name="Definition", description="Blade definition file (.toml, or a windIO turbine .yaml); when empty, "
+        "the preset is used",
         subtype="FILE_PATH", default="",
     )
     preset: StringProperty(
@@ -537,7 +556,7 @@ def export_molds(settings, filepath: str, progress=None) -> str:
     base = pathlib.Path(bpy.path.abspath(settings.base_dir)) if settings.base_dir else None
     defn = blade_from_dict(tomllib.loads(settings.definition_toml), "", base)
     n = max(defn.control_points, settings.fitted_control_points)
-    molds = compute_molds(defn, control_points=n, tolerance=defn.tolerance, fairness=False, progress=progress)
+    molds = compute_molds(defn, control_points=n, tolerance=0.0, fairness=False, progress=progress)
     if settings.mold_halves:
         return write_molds(filepath, molds, units="m")
     return write_iges(filepath, [surface_from_geometry(molds.single, label="SINGLE")], units="m")
@@ -585,6 +604,80 @@ class BLADESMITH_OT_export_wind_blade_iges(_OnRoot, bpy.types.Operator):
         return {"FINISHED"}
 
 
+class BLADESMITH_OT_save_wind_blade_definition(_OnRoot, bpy.types.Operator):
+    """Save the active wind blade's definition as TOML (airfoil paths rewritten for the new folder)"""
+
+    bl_idname = "bladesmith.save_wind_blade_definition"
+    bl_label = "Save Wind Blade Definition"
+    bl_options = {"REGISTER"}
+
+    filepath: StringProperty(name="File Path", subtype="FILE_PATH")
+    filter_glob: StringProperty(default="*.toml", options={"HIDDEN"})
+    check_existing: BoolProperty(default=True, options={"HIDDEN"})
+
+    def invoke(self, context, event):
+        if not self.filepath:
+            name = find_root(context.active_object).bladesmith_wind_blade.definition_name
+            self.filepath = (bpy.path.clean_name(name) or "blade").lower() + ".toml"
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        settings = find_root(context.active_object).bladesmith_wind_blade
+        path = bpy.path.abspath(self.filepath)
+        if not path:
+            self.report({"ERROR"}, "no file path given")
+            return {"CANCELLED"}
+        if pathlib.Path(path).suffix.lower() != ".toml":
+            path += ".toml"
+        base = pathlib.Path(bpy.path.abspath(settings.base_dir)) if settings.base_dir else None
+        try:
+            save_blade(settings_to_dict(settings), path, base)
+        except BladesmithError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        except OSError as exc:
+            self.report({"ERROR"}, f"{path}: cannot write ({exc.strerror or exc})")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Saved {path}")
+        return {"FINISHED"}
+
+
+class BLADESMITH_OT_import_windio_blade(bpy.types.Operator):
+    """Import the blade of a windIO turbine file (YAML, windIO 1.x or 2.x) as wind-blade molds"""
+
+    bl_idname = "bladesmith.import_windio_blade"
+    bl_label = "Import windIO Blade"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: StringProperty(name="File Path", subtype="FILE_PATH")
+    filter_glob: StringProperty(default="*.yaml;*.yml", options={"HIDDEN"})
+    mold_halves: BoolProperty(name="Mold Halves", description="Mold halves; off: the single surface", default=True)
+    control_points: IntProperty(name="Control Points", description="Control points per half to start from; "
+                                "0 = the default", default=0, soft_min=0, soft_max=60)
+    tolerance: FloatProperty(name="Tolerance", description="Largest section deviation as a chord fraction; "
+                             "0 = the default (1e-4)", default=0.0, soft_min=0.0, soft_max=1e-2, precision=6,
+                             step=0.001)
+    fairness: BoolProperty(name="Fairness", description="Compute MVS and strain energy", default=False)
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode == "OBJECT"
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        return bpy.ops.bladesmith.add_wind_blade(
+            definition=self.filepath, mold_halves=self.mold_halves, control_points=self.control_points,
+            tolerance=self.tolerance, fairness=self.fairness)
+
+
+def menu_import_windio(self, context):
+    self.layout.operator(BLADESMITH_OT_import_windio_blade.bl_idname, text="windIO Wind Blade (.yaml)")
+
+
 def menu_add_wind_blade(self, context):
     self.layout.operator_menu_enum(BLADESMITH_OT_add_wind_blade.bl_idname, "preset_choice", text="Wind Blade",
                                    icon="MOD_SIMPLEDEFORM")
@@ -597,6 +690,8 @@ _classes = (
     BLADESMITH_OT_wind_blade_station_add,
     BLADESMITH_OT_wind_blade_station_remove,
     BLADESMITH_OT_export_wind_blade_iges,
+    BLADESMITH_OT_save_wind_blade_definition,
+    BLADESMITH_OT_import_windio_blade,
 )
 _register, _unregister = bpy.utils.register_classes_factory(_classes)
 
@@ -604,8 +699,10 @@ _register, _unregister = bpy.utils.register_classes_factory(_classes)
 def register():
     _register()
     bpy.types.VIEW3D_MT_add.append(menu_add_wind_blade)
+    bpy.types.TOPBAR_MT_file_import.append(menu_import_windio)
 
 
 def unregister():
+    bpy.types.TOPBAR_MT_file_import.remove(menu_import_windio)
     bpy.types.VIEW3D_MT_add.remove(menu_add_wind_blade)
     _unregister()

@@ -14,6 +14,7 @@ import bpy
 from bpy.props import (
     BoolProperty,
     CollectionProperty,
+    EnumProperty,
     FloatProperty,
     FloatVectorProperty,
     IntProperty,
@@ -58,6 +59,8 @@ class BLADESMITH_PG_wind_blade_station(bpy.types.PropertyGroup):
         description="A shipped airfoil name, \"circle\", or a .dat path (relative paths from the definition's folder)",
         default="circle", update=_edited,
     )
+    tolerance: _float("Tolerance", "This station's tolerance as a chord fraction; 0 = the blade's", 0.0,
+                      soft_min=0.0, soft_max=1e-2, precision=6, step=0.001)
     lsq_two_part: _result("LSQ Two-Part", "Least-squares error of the two-part fit (Hosseini Eq. 3), m²", -1.0, 9)
     lsq_single: _result("LSQ Single", "Least-squares error of the single fit (Hosseini Eq. 3), m²; "
                         "-1 for the root-transition stations", -1.0, 9)
@@ -101,6 +104,30 @@ def _annotations() -> dict:
             "fraction of the local chord", default=1e-4, soft_min=1e-6, soft_max=1e-2, precision=6,
             step=0.001, update=_fit_edited,
         ),
+        "section_degree": IntProperty(
+            name="Section Degree p", description="Degree of the section curves (Hosseini Eq. 1)", default=3,
+            min=2, max=5, update=_fit_edited,
+        ),
+        "span_degree": IntProperty(
+            name="Span Degree q", description="Degree across the sections (skinning, Hosseini Eq. 4)", default=3,
+            min=1, max=5, update=_fit_edited,
+        ),
+        "tangent_mode": EnumProperty(
+            name="Tangent at S", description="Magnitude of the tangent at the silhouette point S (Hosseini Fig. 7)",
+            items=[("SQP", "Optimised (SQP)", "Minimise the least-squares error (Hosseini §4)"),
+                   ("HAND", "By Hand", "Upper and lower magnitudes in chords, one ratio for the whole blade")],
+            default="SQP", update=_fit_edited,
+        ),
+        "tangent_upper": FloatProperty(
+            name="Upper Magnitude", description="|C'(1)| of the upper half at S, in chords", default=1.0,
+            soft_min=0.05, soft_max=5.0, precision=4, step=1.0, update=_fit_edited,
+        ),
+        "tangent_lower": FloatProperty(
+            name="Lower Magnitude", description="|C'(0)| of the lower half at S, in chords", default=1.0,
+            soft_min=0.05, soft_max=5.0, precision=4, step=1.0, update=_fit_edited,
+        ),
+        "fitted_ratio": _result("Tangent Ratio", "Upper / lower tangent magnitude at S of the shown molds", 1.0),
+        "aligned_parameters": BoolProperty(default=False),
         "mold_halves": BoolProperty(
             name="Mold Halves", description="Show the upper and lower mold halves, root transitions and parting "
             "lines; off: the single traditional surface", default=True, update=_edited,
@@ -195,10 +222,13 @@ class BLADESMITH_PT_wind_blade(_WindBladePanel, bpy.types.Panel):
         col = layout.column()
         col.use_property_split = True
         for name in ("definition_name", "hub_radius", "mold_direction", "wrap", "smooth_airfoils", "smooth_passes",
-                     "first_aerodynamic_station", "control_points", "tolerance", "mold_halves", "base_dir"):
+                     "first_aerodynamic_station", "control_points", "tolerance", "section_degree", "span_degree",
+                     "tangent_mode", "tangent_upper", "tangent_lower", "mold_halves", "base_dir"):
             row = col.row()
-            row.enabled = name != "smooth_passes" or s.smooth_airfoils
+            row.enabled = ((name != "smooth_passes" or s.smooth_airfoils)
+                           and (name not in ("tangent_upper", "tangent_lower") or s.tangent_mode == "HAND"))
             row.prop(s, name)
+        layout.operator("bladesmith.save_wind_blade_definition", text="Save Wind Blade Definition", icon="FILE_TICK")
 
 
 class _Sub(_WindBladePanel):
@@ -229,6 +259,7 @@ class BLADESMITH_PT_wind_blade_stations(_Sub, bpy.types.Panel):
             col.use_property_split = True
             col.prop(st, "prebend")
             col.prop(st, "sweep")
+            col.prop(st, "tolerance")
             col.label(text=f"LSQ two-part {st.lsq_two_part:.3e}, single "
                       + (f"{st.lsq_single:.3e}" if st.lsq_single >= 0 else "-"))
             col.label(text=f"Deviation {st.deviation:.2e} chord")

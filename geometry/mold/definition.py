@@ -358,3 +358,45 @@ def load_preset(name: str) -> BladeDefinition:
     if key not in presets:
         raise DefinitionError(f"unknown blade preset {name!r}; shipped: {sorted(presets)}", field="preset")
     return load_blade(presets[key])
+
+
+def relocated_airfoil(spec: str, base: pathlib.Path | None, folder: pathlib.Path) -> str:
+    """A station's airfoil entry as it must be written in a definition saved in
+    ``folder``: "circle" and shipped names unchanged; a path (or the windIO file of a
+    ``file.yaml#name`` entry) read from ``base`` made relative to ``folder`` when it can
+    be, else absolute."""
+    import os
+
+    if spec == "circle" or spec in shipped_airfoils():
+        return spec
+    head, sep, rest = spec.partition("#")
+    if not (sep and head.lower().endswith((".yaml", ".yml"))):
+        head, sep, rest = spec, "", ""
+    path = pathlib.Path(head)
+    if not path.is_absolute() and base is not None:
+        path = base / path
+    path = path.resolve()
+    try:
+        head = os.path.relpath(path, folder.resolve())
+    except ValueError:  # another drive
+        head = str(path)
+    return f"{pathlib.Path(head).as_posix()}{sep}{rest}"
+
+
+def save_blade(data: dict, path, base: pathlib.Path | None = None) -> str:
+    """Write the definition ``data`` (TOML layout) to ``path`` atomically, after checking
+    it (:func:`blade_from_dict`) and rewriting its airfoil entries for the new folder
+    (:func:`relocated_airfoil`). Returns the path. "Save Wind Blade Definition"."""
+    from ..files import atomic_write
+    from ..propeller import dumps_toml
+
+    path = pathlib.Path(path)
+    blade_from_dict(data, str(path), base)  # refuse what could not be read back
+    out = dict(data)
+    stations = dict(out["stations"])
+    stations["airfoil"] = [relocated_airfoil(a, base, path.parent) for a in stations["airfoil"]]
+    out["stations"] = stations
+    header = (f"# Wind-blade definition saved by Bladesmith (Hosseini & Moetakef-Imani 2016 molds).\n"
+              f"# Format: README, 'The wind-blade molds'.\n")
+    atomic_write(path, header + dumps_toml(out))
+    return str(path)
