@@ -471,6 +471,9 @@ def _no_fit_message(defn: BladeDefinition, attempts: list, tols: np.ndarray) -> 
 MIN_SECTION_CONTROL_POINTS = 5
 
 
+#: The aligned parameters are tried at a count only when the plain fit failed or came
+#: within this factor of the tolerance.
+ALIGN_RATIO = 4.0
 #: The largest raise of the control-point count between two attempts.
 MAX_CONTROL_POINT_JUMP = 4 * CONTROL_POINT_STEP
 
@@ -502,6 +505,9 @@ def fit_sections(defn: BladeDefinition, splits, n: int, tols: np.ndarray, degree
     attempts = []
     while True:
         for align in (False, True):
+            plain = attempts[-1] if align else None
+            if plain is not None and plain[2] is not None and np.max(plain[2] / tols) > ALIGN_RATIO:
+                continue  # far from the tolerance: the count, not the parameters, is short
             try:
                 fits, rho = _fit_all(splits, aero, n, degree, defn, align, magnitudes)
             except StationFitError as exc:

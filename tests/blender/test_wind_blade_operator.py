@@ -377,3 +377,105 @@ def test_panels_draw_existing_properties_and_operators(root):
                                                       s.stations[0], 0, s, "stations_index")
     assert [name for kind, name in row_calls if kind == "prop"] == ["r", "chord", "twist_deg", "pitch_axis",
                                                                      "airfoil"]
+
+
+# -- issue 19: windIO import, Save Wind Blade Definition, the paper's controls ----------------
+def small_windio(tmp_path, version=2):
+    """A small windIO turbine (the S823 blade's planform, two cylinders at the root) in
+    the YAML subset PyYAML writes, version 1 or 2."""
+    from bladesmith.geometry.sections.airfoil_file import read_airfoil
+
+    foil = read_airfoil(BLADES / "airfoils" / "s823.dat").outline
+    s = [0.0, 0.06, 0.18, 0.3, 0.45, 0.6, 0.75, 0.9, 1.0]
+    chord = [0.12, 0.14, 0.30, 0.28, 0.25, 0.22, 0.19, 0.17, 0.15]
+    twist = [18.0, 18.0, 16.0, 12.0, 8.5, 6.0, 4.0, 3.0, 2.5]
+    pitch = [0.5, 0.5, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3]
+    z = [2.45 * x for x in s]
+    fl = lambda v: "[" + ", ".join(repr(float(x)) for x in v) + "]"  # noqa: E731
+    labels = ["circular", "circular", "S823", "S823"]
+    pos = [0.0, 0.06, 0.18, 1.0]
+    lines = [] if version == 1 else ["windIO_version: '2.0'"]
+    lines += ["name: small test turbine  # made by the test", "components:", "    blade:"]
+    axis = ["x:", f"    grid: {fl([0, 1])}", f"    values: {fl([0, -0.02])}", "y:", f"    grid: {fl([0, 1])}",
+            f"    values: {fl([0, 0])}", "z:", f"    grid: {fl(s)}", f"    values: {fl(z)}"]
+    if version == 1:
+        lines += ["        outer_shape_bem:", "            airfoil_position:", f"                grid: {fl(pos)}",
+                  f"                labels: [{', '.join(labels)}]",
+                  "            chord:", f"                grid: {fl(s)}", f"                values: {fl(chord)}",
+                  "            twist:", f"                grid: {fl(s)}",
+                  f"                values: {fl([np.radians(t) for t in twist])}",
+                  "            pitch_axis:", f"                grid: {fl(s)}", f"                values: {fl(pitch)}",
+                  "            reference_axis: &id001"] + ["                " + a for a in axis]
+    else:
+        lines += ["        reference_axis: &id001"] + ["            " + a for a in axis]
+        lines += ["        outer_shape:", "            chord:", f"                grid: {fl(s)}",
+                  f"                values: {fl(chord)}", "            twist:", f"                grid: {fl(s)}",
+                  f"                values: {fl(twist)}", "            section_offset_y:", f"                grid: {fl(s)}",
+                  f"                values: {fl([c * p for c, p in zip(chord, pitch)])}", "            airfoils:"]
+        for name, p in zip(labels, pos):
+            lines += [f"            -   name: {name}", f"                spanwise_position: {p}"]
+    lines += ["    hub:", "        diameter: 0.5", "airfoils:"]
+    th = np.linspace(0, 2 * np.pi, 41)[:-1]
+    circle = np.column_stack([0.5 + 0.5 * np.cos(th), 0.5 * np.sin(th)])
+    for name, xy in (("circular", circle), ("S823", foil)):
+        lines += [f"-   name: {name}", "    coordinates:", f"        x: {fl(xy[:, 0])}", f"        y: {fl(xy[:, 1])}"]
+    path = tmp_path / f"small_v{version}.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("version", [1, 2])
+def test_import_windio_blade_builds_the_molds(scene, tmp_path, version):
+    path = small_windio(tmp_path, version)
+    before = len(roots())
+    assert bpy.ops.bladesmith.import_windio_blade(filepath=str(path), control_points=S823_CONTROL_POINTS) == {
+        "FINISHED"}
+    (root,) = [r for r in roots()][before:]
+    s = root.bladesmith_wind_blade
+    assert not s.status_is_error and s.definition_name == "small test turbine"
+    assert [row.airfoil for row in s.stations][:3] == ["circle", "circle", f"{path.name}#S823"]
+    assert s.first_aerodynamic_station == 2 and s.stations[-1].prebend == pytest.approx(-0.02)
+    assert {"upper", "lower", "transition_upper", "transition_lower"} <= set(ops.mold_parts(root))
+    # a live edit reads the airfoils from the windIO file again
+    s.stations[4].twist_deg += 0.5
+    assert not s.status_is_error, s.status
+
+
+def test_import_windio_refuses_a_bad_file_and_leaves_the_scene(scene, tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text("components:\n    blade: |\n        text\n")
+    before = snapshot()
+    with pytest.raises(RuntimeError, match=r"bad\.yaml: line 2"):
+        bpy.ops.bladesmith.import_windio_blade(filepath=str(path))
+    assert snapshot() == before
+
+
+def test_save_wind_blade_definition_round_trip(root, tmp_path):
+    s = root.bladesmith_wind_blade
+    s.tangent_mode = "HAND"
+    s.tangent_upper, s.tangent_lower = 1.2, 1.1
+    s.stations[3].tolerance = 5e-4
+    assert not s.status_is_error, s.status
+    assert s.fitted_ratio == pytest.approx(1.2 / 1.1, rel=1e-6)
+    folder = tmp_path / "elsewhere"
+    folder.mkdir()
+    path = folder / "saved.toml"
+    assert bpy.ops.bladesmith.save_wind_blade_definition(filepath=str(path)) == {"FINISHED"}
+    from bladesmith.geometry.mold import load_blade
+
+    again = load_blade(path)  # airfoil paths rewritten for the new folder
+    assert again.tangent_magnitudes == pytest.approx((1.2, 1.1))
+    assert again.station_tolerances[3] == pytest.approx(5e-4) and again.station_tolerances[0] == pytest.approx(
+        s.tolerance)
+    assert [st.r for st in again.stations] == pytest.approx([row.r for row in s.stations])
+    assert bpy.ops.bladesmith.add_wind_blade(definition=str(path), fairness=False) == {"FINISHED"}
+
+
+def test_degrees_are_panel_controls(root):
+    s = root.bladesmith_wind_blade
+    s.span_degree = 2
+    assert not s.status_is_error, s.status
+    assert geometry(ops.mold_parts(root)["upper"]).degree_v == 2
+    s.section_degree = 4
+    assert not s.status_is_error, s.status
+    assert geometry(ops.mold_parts(root)["upper"]).degree_u == 4
