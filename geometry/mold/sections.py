@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.interpolate import BSpline
 from scipy.optimize import brentq, minimize
 
 from ..errors import GeometryError
@@ -192,18 +193,30 @@ class _AffineHalf:
         self.degree = degree
         self.tangent = tangent
         self.at_start = at_start
-        r0 = self._fit(0.0)
-        r1 = self._fit(1.0)
-        self.r0 = _residual(r0, points, self.params).ravel()
-        self.g = _residual(r1, points, self.params).ravel() - self.r0
+        # the fit is affine in λ: two solves give every λ (control points P0 + λ dP), and
+        # one basis matrix gives every residual
+        P0 = self._solve(0.0).control_points
+        self.P0 = np.asarray(P0)
+        self.dP = np.asarray(self._solve(1.0).control_points) - self.P0
+        N = BSpline.design_matrix(self.params, np.asarray(knots, dtype=np.float64), degree)
+        self.r0 = (np.asarray(points) - N @ self.P0).ravel()
+        self.g = -(N @ self.dP).ravel()
 
-    def _fit(self, magnitude: float) -> BSplineCurve:
+    def _solve(self, magnitude: float) -> BSplineCurve:
         D = magnitude * self.tangent
         n_control = len(self.knots) - self.degree - 1
         return fit_least_squares(
             self.points, n_control, self.degree, params=self.params, knots=self.knots,
             start_derivative=D if self.at_start else None, end_derivative=None if self.at_start else D,
         )
+
+    def _fit(self, magnitude: float) -> BSplineCurve:
+        """The constrained fit with derivative magnitude λ at S: P0 + λ dP."""
+        return BSplineCurve(self.degree, self.knots, self.P0 + magnitude * self.dP)
+
+    def residuals(self, magnitude: float) -> np.ndarray:
+        """(N, dim) data minus curve at the data parameters for λ."""
+        return (self.r0 + magnitude * self.g).reshape(len(self.params), -1)
 
     def error(self, magnitude):
         r = self.r0 + magnitude * self.g
@@ -309,8 +322,8 @@ def fit_two_part(split: SplitSection, knots_upper=None, knots_lower=None, n_cont
 def _finish(up: _AffineHalf, lo: _AffineHalf, split: SplitSection, lam_u: float, lam_l: float,
             iterations: int) -> TwoPartFit:
     cu, cl = up._fit(lam_u), lo._fit(lam_l)
-    ru = _residual(cu, split.upper[:-1], up.params[:-1])
-    rl = _residual(cl, split.lower[1:], lo.params[1:])
+    ru = up.residuals(lam_u)[:-1]  # S (interpolated) excluded
+    rl = lo.residuals(lam_l)[1:]
     err = float(np.sum(ru**2) + np.sum(rl**2))
     mx = float(max(np.linalg.norm(ru, axis=1).max(), np.linalg.norm(rl, axis=1).max()))
     return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, iterations)
