@@ -475,7 +475,7 @@ MIN_SECTION_CONTROL_POINTS = 5
 #: within this factor of the tolerance.
 ALIGN_RATIO = 4.0
 #: The largest raise of the control-point count between two attempts.
-MAX_CONTROL_POINT_JUMP = 4 * CONTROL_POINT_STEP
+MAX_CONTROL_POINT_JUMP = 8 * CONTROL_POINT_STEP
 
 
 def _next_step(n: int, attempts: list) -> int:
