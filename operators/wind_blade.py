@@ -49,7 +49,16 @@ import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from ..geometry.errors import BladesmithError, DefinitionError
-from ..geometry.mold import BladeDefinition, BladeMolds, blade_from_dict, build_blade, load_blade, preset_files
+from ..geometry.mold import (
+    BladeDefinition,
+    BladeMolds,
+    blade_from_dict,
+    build_blade,
+    control_point_sweep,
+    format_sweep,
+    load_blade,
+    preset_files,
+)
 from ..geometry.mold.definition import save_blade
 from ..iges.mold import write_molds
 from ..geometry.nurbs import BSplineCurve
@@ -643,6 +652,40 @@ class BLADESMITH_OT_save_wind_blade_definition(_OnRoot, bpy.types.Operator):
         return {"FINISHED"}
 
 
+class BLADESMITH_OT_wind_blade_sweep(_OnRoot, bpy.types.Operator):
+    """Tabulate LSQ error, MVS and strain energy of the two-part molds and the single surface at each control-point count (Hosseini Figs. 5, 8, 10, 11) into a text block"""
+
+    bl_idname = "bladesmith.wind_blade_sweep"
+    bl_label = "Control-Point Sweep"
+    bl_options = {"REGISTER"}
+
+    counts: StringProperty(name="Counts", description="Control points per half, separated by spaces or commas",
+                           default="8 12 16 20")
+
+    def execute(self, context):
+        root = find_root(context.active_object)
+        settings = root.bladesmith_wind_blade
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        try:
+            try:
+                counts = [int(c) for c in self.counts.replace(",", " ").split()]
+            except ValueError:
+                raise DefinitionError(f"expected integers, got {self.counts!r}", field="counts") from None
+            rows = control_point_sweep(settings_to_definition(settings), counts, progress=progress_callback(wm))
+        except BladesmithError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        name = f"{settings.definition_name} sweep"
+        text = bpy.data.texts.get(name) or bpy.data.texts.new(name)
+        text.from_string(f"{settings.definition_name}: control-point sweep (equal total control points)\n\n"
+                         + format_sweep(rows) + "\n")
+        self.report({"INFO"}, f"Sweep of {len(rows)} counts in the text block {name!r}")
+        return {"FINISHED"}
+
+
 class BLADESMITH_OT_import_windio_blade(bpy.types.Operator):
     """Import the blade of a windIO turbine file (YAML, windIO 1.x or 2.x) as wind-blade molds"""
 
@@ -691,6 +734,7 @@ _classes = (
     BLADESMITH_OT_wind_blade_station_remove,
     BLADESMITH_OT_export_wind_blade_iges,
     BLADESMITH_OT_save_wind_blade_definition,
+    BLADESMITH_OT_wind_blade_sweep,
     BLADESMITH_OT_import_windio_blade,
 )
 _register, _unregister = bpy.utils.register_classes_factory(_classes)

@@ -284,6 +284,7 @@ class BLADESMITH_PT_wind_blade_comparison(_Sub, bpy.types.Panel):
             grid.label(text=f"{b:.4e}" if s.fairness_valid else "-")
         row = layout.row(align=True)
         row.operator("bladesmith.wind_blade_fairness", text="Compute Fairness", icon="MOD_SMOOTH")
+        layout.operator("bladesmith.wind_blade_sweep", text="Control-Point Sweep", icon="TEXT")
         row.prop(s, "live_fairness", text="Live")
         if not s.fairness_valid:
             layout.label(text="Fairness not computed for the shown molds", icon="INFO")

@@ -479,3 +479,12 @@ def test_degrees_are_panel_controls(root):
     s.section_degree = 4
     assert not s.status_is_error, s.status
     assert geometry(ops.mold_parts(root)["upper"]).degree_u == 4
+
+
+def test_sweep_writes_the_table_into_a_text_block(root):
+    assert bpy.ops.bladesmith.wind_blade_sweep(counts="8, 10") == {"FINISHED"}
+    text = bpy.data.texts[f"{root.bladesmith_wind_blade.definition_name} sweep"].as_string()
+    rows = [line for line in text.splitlines() if line.startswith("| 8 ") or line.startswith("| 10 ")]
+    assert len(rows) == 2 and "MVS two-part" in text
+    with pytest.raises(RuntimeError, match="counts"):
+        bpy.ops.bladesmith.wind_blade_sweep(counts="8 x")
