@@ -87,9 +87,9 @@ def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
 def blade_surfaces(blade, include_camber: bool = False) -> list[tuple[str, BSplineSurface]]:
     out = [("S", ruled_bspline(blade.suction)), ("P", ruled_bspline(blade.pressure))]
     if blade.leading_edge is not None:
-        out.append(("LE", blade.leading_edge.to_bspline()))
+        out.append(("LE", ruled_bspline(blade.leading_edge)))
     if blade.trailing_edge is not None:
-        out.append(("TE", blade.trailing_edge.to_bspline()))
+        out.append(("TE", ruled_bspline(blade.trailing_edge)))
     if include_camber:
         out.append(("B", ruled_bspline(blade.camber)))
     return out
