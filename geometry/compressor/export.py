@@ -54,11 +54,11 @@ def ruled_bspline(surface: PatchString) -> BSplineSurface:
     return BSplineSurface(lo.degree, 1, lo.knots, np.array([0.0, 0, 1, 1]), P)
 
 
-def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
-    """A wall of revolution as four quarter surfaces (φ in [qπ/2, (q+1)π/2]), each one
-    exact rational quadratic arc in v, so that none is closed and none has a C0 knot in v, with the contour made C1 by choosing the knot spans so that the first
-    derivatives match at the junctions (the channel is G2; interior knots of
-    multiplicity p - 1), falling back to the Bézier form."""
+def reduced_contour(string: BezierString):
+    """The wall contour as a C1 B-spline (interior knots of multiplicity p - 1, knot spans
+    chosen so that the first derivatives match at the junctions: the channel is G2), or
+    the Bézier form when that fails; and the parameter breaks of the channel patches
+    (patch j covers [breaks[j], breaks[j+1]], linearly in U)."""
     p = string.max_degree
     s = string.elevated_to(p)
     h = [1.0]
@@ -68,7 +68,16 @@ def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
         h.append(h[-1] * db / da)
     contour = _reduced_string(s, p - 1, spans=h) if p > 1 else None
     if contour is None:
-        contour = string.to_bspline()
+        return string.to_bspline(), np.arange(string.count + 1, dtype=float)
+    return contour, np.r_[0.0, np.cumsum(h)]
+
+
+def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
+    """A wall of revolution as four quarter surfaces (φ in [qπ/2, (q+1)π/2]), each one
+    exact rational quadratic arc in v, so that none is closed and none has a C0 knot in v, with the contour made C1 by choosing the knot spans so that the first
+    derivatives match at the junctions (the channel is G2; interior knots of
+    multiplicity p - 1), falling back to the Bézier form."""
+    contour, _ = reduced_contour(string)
     knots_c, circle, w_circle = full_circle()
     out = []
     for q in range(4):
