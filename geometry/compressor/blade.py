@@ -365,7 +365,7 @@ DEFAULT_TOLERANCE = 1e-6
 MAX_PATCHES = 256
 MAX_CAP_PATCHES = 64
 #: Samples per patch when measuring the deviations.
-CHECK_SAMPLES = 8
+CHECK_SAMPLES = 4
 #: A C2 cubic interpolant's error falls as h^4: the next count is n (e/tol)^(1/4) times this.
 PATCH_MARGIN = 1.15
 #: Foot points on a wall: Newton iterations and step tolerance (wall parameter).
