@@ -133,3 +133,21 @@ def impeller_surfaces(model: ImpellerModel, blades: int | None = None, include_c
                     surface.control_points @ R.T, surface.weights)
                 out.append((f"{label} {k + 1} {part}", turned))
     return out
+
+
+def construction_summary(model: ImpellerModel) -> tuple[str, bool]:
+    """One line on the adaptive construction of the blades (:func:`.blade.build_blade`):
+    patches chosen, the largest edge-to-wall distance and the camber and thickness errors
+    (metres); and whether every tolerance was met."""
+    parts, met = [], True
+    for label, blade in (("blade", model.blade), ("splitter", model.splitter)):
+        if blade is None or not blade.report:
+            continue
+        r = blade.report
+        met = met and bool(r.get("met", True))
+        parts.append(f"{label} {r['patches']} patches ({r['spacing']}), wall {r['wall_gap']:.2g} m, "
+                     f"camber {r['camber']:.2g} m, thickness {r['thickness']:.2g} m")
+    text = "; ".join(parts)
+    if not met:
+        text = "tolerance NOT met: " + text
+    return text, met
