@@ -11,7 +11,12 @@
   separated) or at ``count`` planes spread over the blade, as poly CURVE (or edge MESH)
   objects; with ``filepath`` a CSV (plane, i, U, v, x, y, z);
 - ``bpy.ops.bladesmith.save_impeller_definition(filepath)``: the root's definition as a TOML
-  file that rebuilds the same wheel (the panel's edits included).
+  file that rebuilds the same wheel (the panel's edits included);
+- ``bpy.ops.bladesmith.fit_impeller(filepath, tolerance, full_wheel)``: an impeller point
+  file (:mod:`..geometry.compressor.points`) fitted in Casey's representation (channel
+  patches, cubic-linear blade surfaces) and shown as an Empty with the wall and blade
+  surfaces as children; the deviation per surface is reported (a WARNING when a surface
+  misses the tolerance).
 """
 import os
 
@@ -226,5 +231,47 @@ class BLADESMITH_OT_save_impeller_definition(_OnImpeller, bpy.types.Operator, Ex
         return {"FINISHED"}
 
 
-_classes = (BLADESMITH_OT_impeller_net, BLADESMITH_OT_impeller_sections, BLADESMITH_OT_save_impeller_definition)
+class BLADESMITH_OT_fit_impeller(bpy.types.Operator):
+    """Fit an impeller from point data (hub and shroud contours, blade generating lines) with Casey's patches"""
+
+    bl_idname = "bladesmith.fit_impeller"
+    bl_label = "Fit Impeller from Points"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filepath: StringProperty(name="Point file", subtype="FILE_PATH", default="")
+    tolerance: FloatProperty(name="Tolerance", default=0.0, min=0.0, precision=6, unit="LENGTH",
+                             description="Fit tolerance in metres (0: 5e-5 of the largest radius)")
+    full_wheel: BoolProperty(name="Full Wheel", default=True)
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode == "OBJECT"
+
+    def execute(self, context):
+        from ..geometry.compressor.points import PointFile, fit_impeller, fitted_surfaces
+        from .nurbs_objects import surface_to_object
+        from .impeller import SURFACE_RESOLUTION
+
+        try:
+            fitted = fit_impeller(PointFile(bpy.path.abspath(self.filepath)), self.tolerance or None)
+            surfaces = fitted_surfaces(fitted, None if self.full_wheel else 1)
+        except BladesmithError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        root = bpy.data.objects.new(fitted.name, None)
+        context.collection.objects.link(root)
+        root["bladesmith_fitted_impeller"] = fitted.summary()
+        for name, surface in surfaces:
+            obj = surface_to_object(surface, f"{root.name} {name}", context.collection, SURFACE_RESOLUTION)
+            _attach(root, obj, name)
+        for obj in context.view_layer.objects:
+            obj.select_set(False)
+        root.select_set(True)
+        context.view_layer.objects.active = root
+        self.report({"INFO"} if fitted.met else {"WARNING"}, fitted.summary())
+        return {"FINISHED"}
+
+
+_classes = (BLADESMITH_OT_impeller_net, BLADESMITH_OT_impeller_sections, BLADESMITH_OT_save_impeller_definition,
+            BLADESMITH_OT_fit_impeller)
 register, unregister = bpy.utils.register_classes_factory(_classes)

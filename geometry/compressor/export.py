@@ -49,9 +49,27 @@ def ruled_bspline(surface: PatchString) -> BSplineSurface:
     lo = _reduced_string(surface.lower, 1)
     up = _reduced_string(surface.upper, 1)
     if lo is None or up is None:
-        return surface.to_bspline()
+        # a fitted string (:mod:`.fitting`) is C2 in its own knot spans, not in unit spans
+        # per patch: take the spans from the polygon legs at the junctions (C1 matching)
+        h = _spans(surface.lower)
+        lo = _reduced_string(surface.lower, 1, spans=h) if h is not None else None
+        up = _reduced_string(surface.upper, 1, spans=h) if h is not None else None
+        if lo is None or up is None:
+            return surface.to_bspline()
     P = np.stack([lo.control_points, up.control_points], axis=1)
     return BSplineSurface(lo.degree, 1, lo.knots, np.array([0.0, 0, 1, 1]), P)
+
+
+def _spans(string: BezierString):
+    """Knot spans that make the string's first derivatives match at the junctions, or None."""
+    h = [1.0]
+    for a, b in zip(string.segments[:-1], string.segments[1:]):
+        da = np.linalg.norm(a.control_points[-1] - a.control_points[-2])
+        db = np.linalg.norm(b.control_points[1] - b.control_points[0])
+        if not (da > 0.0 and db > 0.0):
+            return None
+        h.append(h[-1] * db / da)
+    return h
 
 
 def reduced_contour(string: BezierString):

@@ -126,3 +126,28 @@ def test_nets_and_cuts_to_csv(modules, scene, tmp_path):
 
     with pytest.raises(RuntimeError, match="planes"):
         bpy.ops.bladesmith.impeller_sections(surface="S", planes="-0.06, oops")
+
+
+def test_fit_impeller_operator_builds_the_wheel(modules, scene, tmp_path):
+    import pathlib
+    data = pathlib.Path(__file__).resolve().parents[3] / "shared" / "data" / "compressor" / "dlr_srv2o"
+    if not data.is_dir():
+        pytest.skip("shared SRV2-O data not present")
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "iges"))
+    try:
+        from test_impeller_fit_iges import point_file
+    finally:
+        sys.path.pop(0)
+    path = point_file(tmp_path)
+    assert bpy.ops.bladesmith.fit_impeller(filepath=str(path), tolerance=1.5e-5, full_wheel=False) == {"FINISHED"}
+    root = bpy.context.active_object
+    parts = sorted(c["bladesmith_part"] for c in root.children)
+    assert parts == sorted([f"{w} {i}" for w in ("hub", "shroud") for i in range(1, 5)]
+                           + ["main 1 P", "main 1 S", "splitter 1 P", "splitter 1 S"])
+    assert "deviation" in root["bladesmith_fitted_impeller"]
+    bad = tmp_path / "bad.toml"
+    bad.write_text(path.read_text().replace('units = "mm"', 'units = "furlong"'))
+    before = len(bpy.data.objects)
+    with pytest.raises(RuntimeError, match="units"):
+        bpy.ops.bladesmith.fit_impeller(filepath=str(bad))
+    assert len(bpy.data.objects) == before
