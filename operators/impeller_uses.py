@@ -12,6 +12,10 @@
   objects; with ``filepath`` a CSV (plane, i, U, v, x, y, z);
 - ``bpy.ops.bladesmith.save_impeller_definition(filepath)``: the root's definition as a TOML
   file that rebuilds the same wheel (the panel's edits included);
+- ``bpy.ops.bladesmith.export_impeller_cfd(filepath, full_wheel, include_camber, units)``: the
+  CFD set of the active impeller as IGES (:mod:`..geometry.compressor.cfd`): hub and shroud
+  trimmed at the blade footprints, the blades without the camber sheet B unless asked, one
+  passage or the full wheel;
 - ``bpy.ops.bladesmith.fit_impeller(filepath, tolerance, full_wheel)``: an impeller point
   file (:mod:`..geometry.compressor.points`) fitted in Casey's representation (channel
   patches, cubic-linear blade surfaces) and shown as an Empty with the wall and blade
@@ -231,6 +235,36 @@ class BLADESMITH_OT_save_impeller_definition(_OnImpeller, bpy.types.Operator, Ex
         return {"FINISHED"}
 
 
+class BLADESMITH_OT_export_impeller_cfd(_OnImpeller, bpy.types.Operator, ExportHelper):
+    """Export the CFD set of the active impeller: walls trimmed at the blade footprints, blades, as IGES"""
+
+    bl_idname = "bladesmith.export_impeller_cfd"
+    bl_label = "Export Impeller CFD Set"
+    filename_ext = ".igs"
+    filter_glob: StringProperty(default="*.igs;*.iges", options={"HIDDEN"})
+    full_wheel: BoolProperty(name="Full Wheel", default=False, description="All Z passages (else one passage)")
+    include_camber: BoolProperty(name="Camber Sheet B", default=False, description="Add the camber surface B")
+    units: EnumProperty(name="Units", items=[("MM", "Millimetres", ""), ("M", "Metres", "")], default="MM")
+
+    def execute(self, context):
+        from ..geometry.compressor.cfd import cfd_set
+        from ..iges.impeller import write_cfd_iges
+
+        root = _root(context)
+        try:
+            cfd = cfd_set(_model(root), self.full_wheel, self.include_camber)
+            write_cfd_iges(self.filepath, cfd, units=self.units.lower())
+        except BladesmithError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        except OSError as exc:
+            self.report({"ERROR"}, f"{self.filepath}: cannot write: {exc.strerror}")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"CFD set: {len(cfd.walls)} trimmed walls, {len(cfd.blades)} blade surfaces "
+                              f"-> {os.path.basename(self.filepath)}")
+        return {"FINISHED"}
+
+
 class BLADESMITH_OT_fit_impeller(bpy.types.Operator):
     """Fit an impeller from point data (hub and shroud contours, blade generating lines) with Casey's patches"""
 
@@ -273,5 +307,5 @@ class BLADESMITH_OT_fit_impeller(bpy.types.Operator):
 
 
 _classes = (BLADESMITH_OT_impeller_net, BLADESMITH_OT_impeller_sections, BLADESMITH_OT_save_impeller_definition,
-            BLADESMITH_OT_fit_impeller)
+            BLADESMITH_OT_export_impeller_cfd, BLADESMITH_OT_fit_impeller)
 register, unregister = bpy.utils.register_classes_factory(_classes)

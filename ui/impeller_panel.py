@@ -360,6 +360,7 @@ class BLADESMITH_PT_impeller(bpy.types.Panel):
             col.prop(settings, f"splitter_{key}")
         row = layout.row(align=True)
         row.operator("bladesmith.save_impeller_definition", icon="FILE_TICK")
+        row.operator("bladesmith.export_impeller_cfd", icon="EXPORT")
         row = layout.row(align=True)
         row.operator("bladesmith.impeller_net", icon="MESH_GRID")
         row.operator("bladesmith.impeller_sections", icon="MOD_SLICE")

@@ -151,3 +151,16 @@ def test_fit_impeller_operator_builds_the_wheel(modules, scene, tmp_path):
     with pytest.raises(RuntimeError, match="units"):
         bpy.ops.bladesmith.fit_impeller(filepath=str(bad))
     assert len(bpy.data.objects) == before
+
+
+def test_export_cfd_set(modules, scene, tmp_path):
+    from bladesmith.iges import read_iges
+
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False)
+    path = tmp_path / "passage.igs"
+    assert bpy.ops.bladesmith.export_impeller_cfd(filepath=str(path)) == {"FINISHED"}
+    kinds = [type(g).__name__ for _, g in read_iges(path).to_geometry()]
+    assert len(kinds) == 6 and kinds.count("TrimmedSurfaceGeometry") == 2  # hub, shroud; S, P, LE, TE (no B)
+    path = tmp_path / "passage_b.igs"
+    assert bpy.ops.bladesmith.export_impeller_cfd(filepath=str(path), include_camber=True) == {"FINISHED"}
+    assert len(read_iges(path).to_geometry()) == 7
