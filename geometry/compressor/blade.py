@@ -42,7 +42,7 @@ from scipy.linalg import solve_banded
 from scipy.optimize import brentq
 
 from ..errors import DefinitionError, GeometryError
-from .bezier import BezierCurve, BezierString, PatchString, RuledPatch, bernstein_function, bernstein_function_derivative
+from .bezier import BezierCurve, BezierString, PatchString, bernstein_function, bernstein_function_derivative
 from .channel import MeridionalChannel
 
 #: Gauss–Legendre points per quadrature interval and intervals per wall for m(U), φ(U).

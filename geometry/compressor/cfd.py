@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GeometryError
-from ..nurbs import BSplineCurve, BSplineSurface, approximate, reverse
+from ..nurbs import BSplineCurve, BSplineSurface, approximate, interpolate, reverse
 from .bezier import BezierString
 from .blade import wall_foot
 from .definition import ImpellerModel
@@ -90,33 +90,6 @@ class WallSector:
     outer: Trim
     holes: tuple
 
-    def surface(self) -> BSplineSurface:
-        """The untrimmed sector wall as an exact rational B-spline surface (for checks)."""
-        a0, a1 = self.angle_range
-        c = self.contour.curve
-        n_arcs = max(1, int(math.ceil((a1 - a0) / (0.5 * math.pi))))
-        angles = np.linspace(a0, a1, n_arcs + 1)
-        P, W = [], []
-        for k in range(n_arcs):
-            h = 0.5 * (angles[k + 1] - angles[k])
-            mid = 0.5 * (angles[k + 1] + angles[k])
-            pts = [(angles[k], 1.0), (mid, math.cos(h)), (angles[k + 1], 1.0)]
-            for i, (ang, w) in enumerate(pts):
-                if k and i == 0:
-                    continue
-                rr = 1.0 / math.cos(h) if i == 1 else 1.0
-                P.append((rr * math.cos(ang), rr * math.sin(ang)))
-                W.append(w)
-        P, W = np.array(P), np.array(W)
-        knots_v = np.r_[np.full(3, a0), np.repeat(angles[1:-1], 2), np.full(3, a1)]
-        z, r = c.control_points[:, 0], c.control_points[:, 1]
-        w_u = c.weights if c.weights is not None else np.ones(len(z))
-        net = np.empty((len(z), len(P), 3))
-        net[..., 0] = r[:, None] * P[None, :, 0]
-        net[..., 1] = r[:, None] * P[None, :, 1]
-        net[..., 2] = z[:, None]
-        return BSplineSurface(c.degree, 2, c.knots, knots_v, net, w_u[:, None] * W[None, :])
-
 
 def _edge_curve(surface: BSplineSurface, v: float) -> BSplineCurve:
     """The v = 0 or v = 1 edge of a degree (p, 1) blade surface: its control row, copied."""
@@ -138,8 +111,7 @@ def _pcurve(contour: WallContour, wall: BezierString, model: BSplineCurve, U_gue
         return np.stack([contour.u_of_U(U), phi], axis=1)
 
     inner = np.unique(model.knots[(model.knots > a) & (model.knots < b)])
-    curve = approximate(func, PCURVE_TOLERANCE, degree=3, domain=(a, b), initial_knots=inner)
-    return curve
+    return approximate(func, PCURVE_TOLERANCE, degree=3, domain=(a, b), initial_knots=inner)
 
 
 def _signed_area(curves) -> float:
@@ -217,7 +189,7 @@ def _side(model: ImpellerModel, which: str, contour: WallContour, offset: float)
     B = dict(blade_surfaces(blade, include_camber=True))["B"]
     edge = _edge_curve(B, v)
     t = np.linspace(*edge.domain, SIDE_POINTS)
-    U = corner_U = blade.corner_U[0 if which == "hub" else 1]
+    corner_U = blade.corner_U[0 if which == "hub" else 1]
     if np.isfinite(corner_U).all():
         guess = np.interp(t, np.linspace(*edge.domain, len(corner_U)), corner_U)
     else:
@@ -225,7 +197,6 @@ def _side(model: ImpellerModel, which: str, contour: WallContour, offset: float)
     X = edge.evaluate(t)
     U, _ = wall_foot(wall, np.stack([X[:, 2], np.hypot(X[:, 0], X[:, 1])], axis=1), guess)
     uphi = np.stack([contour.u_of_U(U), np.unwrap(np.arctan2(X[:, 1], X[:, 0])) + offset], axis=1)
-    from ..nurbs import interpolate
     middle = interpolate(uphi, 3)
     u_in, u_out = float(contour.breaks[0]), float(contour.breaks[-1])
     start, end = middle.control_points[0], middle.control_points[-1]
@@ -290,7 +261,6 @@ def cfd_set(model: ImpellerModel, full_wheel: bool = False, include_camber: bool
             shift = k * pitch
             low = [_shifted(c, shift) for c in lower]
             up = [reverse(_shifted(c, shift + pitch)) for c in reversed(lower)]
-            u_in, u_out = float(contour.breaks[0]), float(contour.breaks[-1])
             outlet = _line(low[-1].control_points[-1], up[0].control_points[0])
             inlet = _line(up[-1].control_points[-1], low[0].control_points[0])
             outer = tuple(low) + (outlet,) + tuple(up) + (inlet,)

@@ -68,7 +68,6 @@ from scipy.optimize import minimize
 
 from ..errors import DefinitionError, GeometryError
 from ..nurbs import closest_point_curve, closest_point_surface
-from .bezier import PatchString
 from .channel import MeridionalChannel
 from .fitting import fit_channel, fit_ruled_surface, trim_lines_to_channel
 
