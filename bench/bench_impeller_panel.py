@@ -27,7 +27,7 @@ def main() -> dict:
         s = bpy.context.active_object.bladesmith_impeller
         edits = {
             "blade count 15 <-> 14": ("blade_count", 15, 14),
-            "patches 6 <-> 7": ("patches", 6, 7),
+            "patches 65 <-> 66": ("patches", 65, 66),
             "tolerance 1e-6 <-> 2e-6": ("tolerance", 1e-6, 2e-6),
             "LE rounding 3 <-> 2.5": ("leading_edge_ratio", 3.0, 2.5),
             "TE rounding 0 <-> 2": ("trailing_edge_ratio", 0.0, 2.0),
@@ -50,7 +50,7 @@ def main() -> dict:
         d = ops.load_definition(preset="high_flow")
         fixed = dataclasses.replace(d, blade=dataclasses.replace(d.blade, tolerance=0.0))
         rows.append(("baseline: geometry, adaptive (1e-6 D)", median_time(lambda: impeller_surfaces(d.build(), 1), 5), ""))
-        rows.append(("baseline: geometry, fixed 6 patches", median_time(lambda: impeller_surfaces(fixed.build(), 1), 5), ""))
+        rows.append(("baseline: geometry, fixed 65 patches", median_time(lambda: impeller_surfaces(fixed.build(), 1), 5), ""))
         report("impeller panel edits (high_flow, first blade)", rows)
     finally:
         addon.unregister()
