@@ -20,7 +20,7 @@ import numpy as np
 from bpy.props import BoolProperty, EnumProperty, StringProperty
 
 from ..geometry.compressor import ImpellerDefinition, blade_net, distribution, dumps_toml
-from ..geometry.compressor.export import impeller_surfaces
+from ..geometry.compressor.export import construction_summary, impeller_surfaces
 from ..geometry.errors import BladesmithError, DefinitionError
 from .nurbs_objects import PROPERTY_KEY, remove_object, surface_to_object, write_surface
 
@@ -179,15 +179,18 @@ class BLADESMITH_OT_add_impeller(bpy.types.Operator):
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         summary = "" if model.standardisation is None else model.standardisation.summary()
+        construction, met = construction_summary(model)
         settings = getattr(root, "bladesmith_impeller", None)
         if settings is not None:
-            settings.load(definition, self.full_wheel, summary)
+            settings.load(definition, self.full_wheel, summary, construction)
         for obj in context.view_layer.objects:
             obj.select_set(False)
         root.select_set(True)
         context.view_layer.objects.active = root
         if summary:
             self.report({"INFO"}, f"{definition.name}: {summary}")
+        if construction:
+            self.report({"INFO"} if met else {"WARNING"}, f"{definition.name}: {construction}")
         return {"FINISHED"}
 
 

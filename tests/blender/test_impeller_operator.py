@@ -162,7 +162,7 @@ def test_standardised_impeller_exports_to_iges(impeller_modules, scene, tmp_path
     assert bpy.ops.export_scene.iges(filepath=str(path), units="MM") == {"FINISHED"}
     _, reference = _standardised_reference(root)
     written = [g for _, g in read_iges(path).to_geometry()]
-    assert len(written) == 8 + 15 * 3 + 15 * 3 + 2  # walls, S P LE of blades and splitters, B of blade 1 and splitter 1
+    assert len(written) == 8 + 15 * 4 + 15 * 4 + 2  # walls, S P LE TE of blades and splitters, B of blade 1 and splitter 1
     S = reference["blade 1 S"]
     assert any(g.shape == S.shape and np.array_equal(g.control_points, 1000.0 * S.control_points) for g in written)
     result = occ.read_with_occ(path)
