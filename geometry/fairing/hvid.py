@@ -75,6 +75,13 @@ DIVERGENCE_FACTOR = 1e3
 #: bounding-box diagonal): float32 coordinates (Blender) round at ~6e-8.
 CLOSED_TOL = 1e-6
 
+#: Ends that meet at an angle larger than this (degrees) make a corner, not a closed
+#: curve: a sharp airfoil trailing edge read by smooth2D is an open curve whose ends
+#: coincide. Smoothed as a periodic cubic its corner would become a curvature spike of
+#: ~1e4 that no smoothing can follow.
+CORNER_ANGLE_DEG = 5.0
+CORNER_TURN_RATIO = 3.0
+
 #: Trailing-edge gap (fraction of chord) below which an airfoil counts as sharp.
 SHARP_TE_TOL = 1e-9
 
@@ -543,6 +550,7 @@ def newton_curvature(
 
     history: list[tuple[float, float]] = []
     first = None
+    target = np.array(target, dtype=np.float64)
     for iteration in range(1, int(max_iterations) + 1):
         kappa = op.curvature(P)
         residual = kappa - target
@@ -563,6 +571,21 @@ def newton_curvature(
         except np.linalg.LinAlgError:
             history.append((errf, float("nan")))
             return build(P), history, False, "the Jacobian is singular"
+        if closed:
+            delta = _without_rigid_modes(delta, P[rows], normals)
+        if np.max(np.abs(delta)) > MAX_STEP:
+            # The step asks for more than the curve can give: κ* − κ has a part along J's
+            # weakest direction, which no reasonable displacement produces (ends at one
+            # point, e.g. a cylinder read as an airfoil: the turn about that point, which
+            # curvature cannot see). Take that part out of κ* (the least change of the
+            # target that makes it reachable) and solve again.
+            y = _weakest_left_vector(bands, closed)
+            shift = y * float(y @ residual)
+            target = target + shift
+            residual = residual - shift
+            delta = _solve_jacobian(bands, -residual, closed)
+            if closed:
+                delta = _without_rigid_modes(delta, P[rows], normals)
         errx = float(np.sum(np.abs(delta)))
         history.append((errf, errx))
         if not np.all(np.isfinite(delta)) or np.max(np.abs(delta)) > MAX_STEP:
@@ -577,6 +600,33 @@ def newton_curvature(
             history.append((float(np.sum(np.abs(kappa - target))), 0.0))
             return build(P), history, True, "tolx"
     return build(P), history, False, f"ntrial = {max_iterations} iterations reached"
+
+
+def _weakest_left_vector(bands: np.ndarray, closed: bool = False, iterations: int = 4) -> np.ndarray:
+    """Unit left singular vector of the smallest singular value of the (cyclic, when
+    ``closed``) tridiagonal J (``bands`` as in :func:`_jacobian_bands`), by inverse
+    iteration on Jᵀ: Jᵀ[i, i−1] = J[i−1, i] = bands[2, i−1], Jᵀ[i, i+1] = J[i+1, i] =
+    bands[0, i+1]."""
+    transposed = np.stack([np.roll(bands[2], 1), bands[1], np.roll(bands[0], -1)])
+    y = np.random.default_rng(0).standard_normal(bands.shape[1])
+    for _ in range(iterations):
+        y = _solve_jacobian(transposed, y, closed)
+        y /= np.linalg.norm(y)
+    return y
+
+
+def _without_rigid_modes(delta: np.ndarray, vertices: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """``delta`` less its least-squares component along the normal displacements of the
+    rigid motions of a closed curve (the two translations and the turn about the
+    centroid). Rigid motions leave every κ_i unchanged, so the cyclic J is (nearly)
+    singular along them and round-off in the finite-difference Jacobian (§3.2 step 3)
+    grows there from one iteration to the next: on a Blender Bezier circle the residual
+    fell to 7e-9 and then rose tenfold per iteration. Removing them changes J δ only to
+    first order in the round-off."""
+    arm = vertices - vertices.mean(axis=0)
+    M = np.stack([normals[:, 0], normals[:, 1], normals[:, 1] * arm[:, 0] - normals[:, 0] * arm[:, 1]], axis=1)
+    coef, *_ = np.linalg.lstsq(M, delta, rcond=None)
+    return delta - M @ coef
 
 
 # =======================================================================================
@@ -758,10 +808,42 @@ def _rigid_align(curve: BSplineCurve, reference: BSplineCurve, params: np.ndarra
     return curve.with_control_points(cb + (curve.control_points - ca) @ R.T)
 
 
-def _fail(kind: str, history, reason: str):
+def advice(history, reason: str, settings: "SmoothingSettings | None" = None) -> str:
+    """What to change, read from the residual history (Σ|κ − κ*| per iteration) and the
+    reason the iteration stopped (Hvid 1993 §3.2.2: a target curvature that asks too much
+    does not converge; §3.4: ntrial, tolx, tolf)."""
+    f = np.array([h[0] for h in history], dtype=np.float64)
+    s = settings or SmoothingSettings()
+    if "non-finite" in reason:
+        return ("the curvature became infinite: the curve has a cusp, a corner or nearly repeated points; "
+                "remove them, or use more smoothing points (nsmooth) so each corner is resolved")
+    if "singular" in reason:
+        return "the Jacobian is singular: the curve folds back on itself; check the point order"
+    if f.size >= 2 and "ntrial" in reason:
+        best = int(np.argmin(f))
+        if best < f.size - 1 and f[-1] > 2.0 * f[best]:
+            return (f"the residual fell to {f[best]:.3g} at iteration {best + 1} and then rose (round-off): "
+                    f"set tolf to {10 * f[best]:.2g} or more")
+        rate = f[-1] / f[-2] if f[-2] > 0 else 1.0
+        if rate < 0.5 and f[-1] > 0:
+            more = int(np.ceil(np.log(max(s.tolf, 1e-300) / f[-1]) / np.log(rate))) if s.tolf > 0 else 10
+            return (f"the residual still falls (×{rate:.2g} per iteration, now {f[-1]:.3g}): "
+                    f"raise max_iterations (ntrial) to about {len(f) + max(more, 1) + 2}")
+        return (f"the residual stalls at {f[-1]:.3g}: the target curvature cannot be reached; "
+                "smooth less (fewer passes, or the least-squares smoother), use smoothing type 1 "
+                f"on a closed curve, or accept it with tolf = {2 * f[-1]:.2g}")
+    if "diverg" in reason or "exceeds" in reason:
+        return (f"the first residual {f[0]:.3g} asks for more than a small correction: "
+                "smooth less (fewer passes, or the least-squares smoother), use more smoothing points "
+                "(nsmooth) where the curvature changes fast (smaller α), or check for a corner in the curve"
+                if f.size else "smooth less (fewer passes)")
+    return "smooth less (fewer passes, or the least-squares smoother), or use more iterations"
+
+
+def _fail(kind: str, history, reason: str, settings: "SmoothingSettings | None" = None):
     raise SmoothingNotConverged(
-        f"{kind}: the smoothing did not converge (Hvid 1993 §3.2.2: smooth less, e.g. fewer passes, "
-        f"or use more iterations); the curve was not changed",
+        f"{kind}: the smoothing did not converge; the curve was not changed. What to change: "
+        f"{advice(history, reason, settings)}",
         history,
         reason,
     )
@@ -826,7 +908,7 @@ def smooth2d(
     eye = np.eye(2)
     if closed is None:
         ends = raw.evaluate(np.array(raw.domain)) if raw is not None else points[[0, -1]]
-        closed = bool(np.linalg.norm(ends[1] - ends[0]) <= CLOSED_TOL * ref)
+        closed = bool(np.linalg.norm(ends[1] - ends[0]) <= CLOSED_TOL * ref) and not _corner_at_join(raw, points)
     if raw is not None:
         source = _transform_curve(raw, 1.0 / ref, eye, -lo / ref)
         data_points = source.evaluate(span_samples(source, 1))
@@ -845,7 +927,7 @@ def smooth2d(
         source, fractions, output_fractions, settings, progress, closed=closed
     )
     if not converged and raise_on_failure:
-        _fail("smooth2D", history, reason)
+        _fail("smooth2D", history, reason, settings)
     deviation = _deviation(curve, unsmoothed, params, data_points, measure)
     out_fr = curvature_fractions(curve, settings.output_points, alpha)
     out_points = curve.evaluate(params_at_arclength(curve, out_fr))
@@ -874,6 +956,27 @@ def smooth2d(
 # =======================================================================================
 # smoothfoil
 # =======================================================================================
+def _corner_at_join(raw: BSplineCurve | None, points: np.ndarray | None) -> bool:
+    """Do the two ends of a curve whose ends coincide meet in a corner? A curve's end
+    tangents at more than :data:`CORNER_ANGLE_DEG`; points: the turn between the last and
+    the first chord both above that angle and more than :data:`CORNER_TURN_RATIO` times the
+    turn at either neighbouring point (a closed outline turns by about the same angle at
+    every point; a sharp trailing edge turns by much more at the join than next to it)."""
+    def turn(a, b):
+        na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+        if na == 0.0 or nb == 0.0:
+            return np.pi
+        return float(np.arccos(np.clip(np.dot(a, b) / (na * nb), -1.0, 1.0)))
+
+    limit = np.radians(CORNER_ANGLE_DEG)
+    if raw is not None:
+        return turn(raw.derivatives(raw.domain[0], 1)[1], raw.derivatives(raw.domain[1], 1)[1]) > limit
+    c = np.diff(points, axis=0)
+    at_join = turn(c[-1], c[0])
+    beside = max(turn(c[0], c[1]), turn(c[-2], c[-1]))
+    return at_join > limit and at_join > CORNER_TURN_RATIO * beside
+
+
 def _farthest_point(curve: BSplineCurve, origin: np.ndarray) -> float:
     """Parameter of the point of ``curve`` farthest from ``origin`` (the leading edge seen
     from the trailing edge): dense samples, then Newton on (C − T)·C' = 0."""
@@ -1014,7 +1117,7 @@ def smoothfoil(
         source, fractions, output_fractions, settings, progress, rescale_chord if rescale else None
     )
     if not converged and raise_on_failure:
-        _fail("smoothfoil", history, reason)
+        _fail("smoothfoil", history, reason, settings)
     u_out = params_at_arclength(curve, output_fractions)
     out_points = curve.evaluate(u_out)
     cut = curve
