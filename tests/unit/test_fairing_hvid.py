@@ -391,3 +391,19 @@ def test_advice_reads_the_history():
     with pytest.raises(SmoothingNotConverged, match="raise max_iterations"):
         smoothfoil(naca0012(121) + np.random.default_rng(3).uniform(-1e-4, 1e-4, (121, 2)) * [0, 1],
                    NACA_DISTRIBUTION, SmoothingSettings(max_iterations=2))
+
+
+def test_closed_curves_converge_with_either_smoothing_type():
+    # κ* corrected for turning and closure (_keep_turning): type 2's kept maximum on a
+    # 2:1 ellipse stalled at 0.198 before; the noisy cylinder (6-digit data) as a closed
+    # curve rose from 32 to 300
+    import pathlib
+
+    from bladesmith.geometry.sections.airfoil_file import read_airfoil
+
+    r = smooth2d(bezier_circle(2.0, 1.0), 3.0, SmoothingSettings(smoothing_type=2))
+    assert r.converged and r.deviation.true < 1e-3
+    shared = pathlib.Path(__file__).resolve().parents[3] / "shared" / "data"
+    cylinder = read_airfoil(shared / "airfoils" / "nrel5mw_Cylinder1.dat").outline
+    r = smooth2d(cylinder, 3.0, SmoothingSettings(smoothing_type=1))
+    assert r.converged and r.history[-1][0] < 0.05 * r.history[0][0] and r.deviation.true < 1e-4
