@@ -928,8 +928,7 @@ def smooth2d(
         raise GeometryError("smooth2D: the curve has zero extent")
     eye = np.eye(2)
     if closed is None:
-        ends = raw.evaluate(np.array(raw.domain)) if raw is not None else points[[0, -1]]
-        closed = bool(np.linalg.norm(ends[1] - ends[0]) <= CLOSED_TOL * ref) and not _corner_at_join(raw, points)
+        closed = _closed(raw, points, ref)
     if raw is not None:
         source = _transform_curve(raw, 1.0 / ref, eye, -lo / ref)
         data_points = source.evaluate(span_samples(source, 1))
@@ -977,6 +976,23 @@ def smooth2d(
 # =======================================================================================
 # smoothfoil
 # =======================================================================================
+def is_closed(data) -> bool:
+    """Would :func:`smooth2d` smooth ``data`` (points (m, 2) or a 2-D BSplineCurve) as a
+    closed curve: its ends within :data:`CLOSED_TOL` of its size and meeting without a
+    corner (:data:`CORNER_ANGLE_DEG`)?"""
+    if isinstance(data, BSplineCurve):
+        raw, points = (data, None) if data.degree >= 2 else (None, _as_points(data.control_points, "curve control points"))
+    else:
+        raw, points = None, _as_points(data, "points")
+    sample = raw.evaluate(span_samples(raw, 4)) if raw is not None else points
+    return _closed(raw, points, float(np.linalg.norm(np.ptp(sample, axis=0))))
+
+
+def _closed(raw: BSplineCurve | None, points: np.ndarray | None, size: float) -> bool:
+    ends = raw.evaluate(np.array(raw.domain)) if raw is not None else points[[0, -1]]
+    return bool(np.linalg.norm(ends[1] - ends[0]) <= CLOSED_TOL * size) and not _corner_at_join(raw, points)
+
+
 def _corner_at_join(raw: BSplineCurve | None, points: np.ndarray | None) -> bool:
     """Do the two ends of a curve whose ends coincide meet in a corner? A curve's end
     tangents at more than :data:`CORNER_ANGLE_DEG`; points: the turn between the last and
