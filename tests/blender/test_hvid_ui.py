@@ -89,3 +89,12 @@ def test_sidebar_settings_and_distribution_plot(scene):
     # where the slope of f is small the ticks crowd (Fig. 3.11): LE ticks closer than TE ones
     f = np.array(bpy.context.scene.bladesmith_hvid.polynomial_distribution().fractions(180))
     assert plot_pixels(f).shape == (128, 256, 4)
+
+
+@pytest.mark.parametrize("mold_halves", [True, False])
+def test_wind_blade_report_has_fairness_in_both_modes(scene, mold_halves):
+    assert bpy.ops.bladesmith.add_wind_blade(preset="S823_SMALL", mold_halves=mold_halves) == {"FINISHED"}
+    root = next(o for o in bpy.context.scene.objects if o.parent is None and o.type == "EMPTY")
+    status = root.bladesmith_wind_blade.status
+    assert "MVS two-part" in status and "strain energy two-part" in status
+    assert ("shown: mold halves" if mold_halves else "shown: single surface") in status

@@ -370,7 +370,10 @@ def test_cylinder_read_as_airfoil_converges():
     shared = pathlib.Path(__file__).resolve().parents[3] / "shared" / "data"
     foil = read_airfoil(shared / "airfoils" / "nrel5mw_Cylinder1.dat")
     r = smoothfoil(foil)  # was: "a step of 1.06 exceeds 0.05" on the first iteration
-    assert r.converged and len(r.history) <= 8
+    # within the jobcard's ntrial = 10 (measured 9); type 2 finds no leading-edge peak on a
+    # circle and smooths every point (keeping its noisiest point bent it by 1.2e-2 c)
+    assert r.converged and len(r.history) <= 10
+    assert r.deviation.true < 1e-3  # measured 6.5e-4
 
 
 def test_sharp_trailing_edge_is_an_open_curve_for_smooth2d():
