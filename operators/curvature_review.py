@@ -997,8 +997,8 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
         columns = [("before", before, -spacing), ("after", maps, 0.0), ("deviation", after_dev, spacing)]
     times["review"] = time.perf_counter() - clock
     framed = [o for o in maps if not is_hub(_source_of(o))] or maps
-    views = _wind_views(framed, panel_size) if not any(
-        _source_of(o) is not None and _source_of(o).get("bladesmith_part") == "blade" for o in maps) else None
+    wind = any(_source_of(o) is not None and _source_of(o).get("bladesmith_mold_part") is not None for o in maps)
+    views = _wind_views(framed, panel_size) if wind else None
     if views is None:
         views = review_views(maps)
         if len(columns) > 1:
@@ -1006,7 +1006,10 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
     # landmarks of the reference blade only (a propeller's copies are rendered, not labelled)
     blade0 = [o for o in framed if _source_of(o) is not None and int(_source_of(o).get("bladesmith_blade", 0)) == 0]
     P, _, _ = _map_points(blade0 or framed)
-    blade_like = views[0].get("row") or any(
+    # labels only where root, tip and the edges are known to mean what they say: a wind
+    # blade or a propeller blade (an impeller blade's hub and shroud edges are not a root
+    # and a tip along one axis)
+    blade_like = wind or any(
         _source_of(o) is not None and _source_of(o).get("bladesmith_part") == "blade" for o in maps)
     made_objects, made_meshes = [], []
     temp = bpy.data.scenes.new("Bladesmith review render")
