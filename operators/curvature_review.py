@@ -816,6 +816,32 @@ def _write_png(pixels: np.ndarray, path: str) -> None:
         bpy.data.images.remove(img)
 
 
+def _propeller_edges(maps) -> dict:
+    """World positions of a Bladesmith propeller blade's LE and TE at mid-span, from its
+    first surface (patch 0 of blade 0: the smoothed blade's pressure_central, or the whole
+    unsmoothed blade): u runs along +ξ from the trailing edge (ξ = 0) to the leading edge
+    (ξ = 1/2) on either hand (geometry/propeller/blade.py)."""
+    for obj in maps:
+        src = _source_of(obj)
+        if src is None or src.get("bladesmith_part") != "blade" or src.get("bladesmith_patch") != 0 \
+                or int(src.get("bladesmith_blade", 0)) != 0:
+            continue
+        surfaces = [e for e in object_to_geometry(src) if isinstance(e, BSplineSurface)]
+        if not surfaces:
+            return {}
+        S = surfaces[0]
+        (u0, u1), (v0, v1) = S.domain_u, S.domain_v
+        v = 0.5 * (v0 + v1)
+        M = np.array(src.matrix_world)
+        pts = np.array([S.evaluate(u1, v), S.evaluate(u0, v)]).reshape(2, -1)[:, :3]
+        if np.linalg.norm(pts[0] - pts[1]) <= 1e-9 * max(S.size(), 1e-12):
+            # the unsmoothed blade is one surface around the section, TE -> LE (ξ = 1/2) -> TE
+            pts[0] = np.asarray(S.evaluate(0.5 * (u0 + u1), v)).reshape(-1)[:3]
+        world = pts @ M[:3, :3].T + M[:3, 3]
+        return {"LE": world[0], "TE": world[1]}
+    return {}
+
+
 def _source_of(obj):
     key = _role(obj)
     return bpy.data.objects.get(key[2]) if key and key[0] == "map" else None
@@ -928,7 +954,7 @@ def _overlay_objects(view, landmarks: dict, centre: np.ndarray, made_meshes: lis
         screen = np.array([np.dot(d, right), np.dot(d, up)])
         n = np.linalg.norm(screen)
         screen = screen / n if n > 0 else np.array([0.0, 1.0])
-        offset = screen * 1.6 * size
+        offset = screen * 2.2 * size
         text(name, point, offset[0] - 0.3 * size * len(name), offset[1] - 0.35 * size, name)
     # scale bar in the lower left corner
     length = nice_length(0.22 * 2 * half_w)
@@ -1011,6 +1037,7 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
     # and a tip along one axis)
     blade_like = wind or any(
         _source_of(o) is not None and _source_of(o).get("bladesmith_part") == "blade" for o in maps)
+    propeller_edges = _propeller_edges(maps)
     made_objects, made_meshes = [], []
     temp = bpy.data.scenes.new("Bladesmith review render")
     world = bpy.data.worlds.new("Bladesmith review world")
@@ -1076,6 +1103,8 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
             else:
                 side = view["side"]
             landmarks = blade_landmarks(P, span, side) if blade_like else {}
+            if landmarks:
+                landmarks.update(propeller_edges)
             centre = P.mean(axis=0)
             panels = []
             for c, (label, group, dx) in enumerate(columns):
