@@ -56,7 +56,6 @@ from ..files import atomic_write
 from ..errors import DefinitionError, GeometryError
 from ..nurbs import BSplineCurve, closest_point_curve, split
 from ..nurbs.basis import basis_function_derivatives, basis_functions, find_span
-from ..sections.airfoil_file import Airfoil
 from .curvature import arclength_table, curvature_at, derivatives, params_at_arclength, span_samples
 from .distributions import DistributionReport, PolynomialDistribution, curvature_fractions, distribution_report
 
@@ -1123,7 +1122,7 @@ def smoothfoil(
 ) -> SmoothingResult:
     """Hvid's smoothfoil (1993 §3.2.1, §3.3, §3.4): smooth an airfoil outline.
 
-    data: an :class:`Airfoil` (taken lower side first, TE → lower → LE → upper → TE, the
+    data: an ``Airfoil`` of ``sections.airfoil_file`` (taken lower side first, TE → lower → LE → upper → TE, the
     order of the paper's fx66 file, so f(½) = 0.491 puts the leading edge at the middle
     point), or (m, 2) outline points TE → LE → TE in either direction and at any chord,
     position and angle (§3.3: smoothed at unit chord, mapped back).
@@ -1134,7 +1133,9 @@ def smoothfoil(
     """
     settings = settings or SmoothingSettings()
     distribution = distribution or PolynomialDistribution(0.5, 0.5, 0.491, 0.1)
-    if isinstance(data, Airfoil):
+    # an Airfoil (sections/airfoil_file.py) by its sides: importing the class would make
+    # the two modules import each other (airfoil_file smooths with this one)
+    if hasattr(data, "lower") and hasattr(data, "upper"):
         points = np.concatenate([data.lower[::-1], data.upper[1:]])
     else:
         points = _as_points(data, "airfoil outline")
