@@ -955,6 +955,10 @@ def _overlay_objects(view, landmarks: dict, centre: np.ndarray, made_meshes: lis
         n = np.linalg.norm(screen)
         screen = screen / n if n > 0 else np.array([0.0, 1.0])
         offset = screen * 2.2 * size
+        if name == "tip" and not view.get("row"):
+            offset = np.array([1.0 * size, 0.4 * size])  # beside the tip, clear of the panel's title
+            text(name, point, offset[0], offset[1], name)
+            continue
         text(name, point, offset[0] - 0.3 * size * len(name), offset[1] - 0.35 * size, name)
     # scale bar in the lower left corner
     length = nice_length(0.22 * 2 * half_w)
@@ -1149,7 +1153,7 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
         clear_scene()
         lines = [title or default_title(maps) or "curvature review", _settings_line(settings),
                  f"{settings.get('sign_convention', '')}" + ("; " if settings.get("sign_convention") else "")
-                 + "thin grey lines: edges of the NURBS surfaces (patches)"]
+                 + "grey lines: edges of the NURBS surfaces"]
         text_h = 0.03
         for n, body in enumerate(lines):
             mesh = _text_mesh(body, f"Bladesmith review heading {n}", text_h * (1.25 if n == 0 else 1.0))
