@@ -80,10 +80,10 @@ def main(argv=None) -> int:
             surfaces = [o for o in bpy.context.scene.objects if o.type == "SURFACE"]
             if not only or "nrel" in only:
                 run("review_nrel5mw_molds.png", surfaces, "NREL 5-MW blade (preset NREL5MW), mold halves "
-                    "(Hosseini 2016)", percentile=95.0, comb_lines=0)
+                    "(Hosseini 2016)", percentile=95.0, comb_lines=0, panel_size=360)
             if not only or "zebra" in only:
                 run("review_nrel5mw_zebra.png", surfaces, "NREL 5-MW blade (preset NREL5MW), mold halves: zebra "
-                    "stripes", quantity="zebra", comb_lines=0, samples_per_span=16)
+                    "stripes", quantity="zebra", comb_lines=0, samples_per_span=16, panel_size=360)
         if not only or "impeller" in only:
             fresh()
             assert bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False) == {"FINISHED"}
