@@ -44,6 +44,19 @@ from mathutils import Matrix, Vector
 
 from ..geometry.errors import BladesmithError, GeometryError
 from ..geometry.fairing.review import DEFAULT_SAMPLES_PER_SPAN, surface_map, surface_numbers
+from ..geometry.fairing.review_display import (
+    NON_NEGATIVE,
+    blade_landmarks,
+    length_label,
+    nice_length,
+    segment_count,
+    sequential_colours,
+    span_segments,
+    sign_convention,
+    upper_limit,
+    zebra_colours,
+    zebra_values,
+)
 from ..geometry.fairing.surface_curvature import (
     DEFAULT_PERCENTILE,
     comb_scale,
@@ -87,12 +100,15 @@ QUANTITY_ITEMS = (
     ("max_abs", "Largest principal", "The principal curvature of larger magnitude (1/m)"),
     ("strain_energy", "Strain energy density", "κ1² + κ2² (1/m²)"),
     ("mvs", "MVS density", "(∂κ1/∂e1)² + (∂κ2/∂e2)² (1/m⁴)"),
+    ("zebra", "Zebra stripes", "Reflection lines of parallel light stripes: bent or broken stripes show curvature "
+                               "jumps and creases"),
 )
 LABELS = {
     "mean": ("mean curvature H", "1/m"), "gaussian": ("Gaussian curvature K", "1/m²"),
     "k1": ("principal curvature κ1", "1/m"), "k2": ("principal curvature κ2", "1/m"),
     "max_abs": ("largest principal curvature", "1/m"), "strain_energy": ("κ1² + κ2²", "1/m²"),
     "mvs": ("MVS density", "1/m⁴"), "deviation": ("deviation from reference", "m"),
+    "zebra": ("zebra stripes", "reflection lines"),
 }
 
 
@@ -300,10 +316,16 @@ def legend_lines(settings: dict) -> tuple[str, list[tuple[float, str]]]:
     name, units = LABELS.get(settings["quantity"], (settings["quantity"], ""))
     lo, hi = settings["limits"]
     title = f"{name} ({units})"
-    if settings.get("percentile", 100) < 100:
+    if settings.get("quantity") == "zebra":
+        title = f"{name} ({units})" + (f": {settings['sign_convention']}" if settings.get("sign_convention") else "")
+    elif settings.get("percentile", 100) < 100:
         title += f", limits at the {settings['percentile']:g}th area percentile of |value|"
         title += f" ({100 * settings.get('clipped', 0):.1f}% of the area beyond)"
+    if settings.get("quantity") != "zebra" and settings.get("sign_convention"):
+        title += f"; {settings['sign_convention']}"
     ticks = [(t, _format(lo + t * (hi - lo))) for t in (0.0, 0.25, 0.5, 0.75, 1.0)]
+    if settings.get("quantity") == "zebra":
+        ticks = [(0.0, "dark stripe"), (1.0, "light stripe")]
     return title, ticks
 
 
@@ -321,7 +343,7 @@ def build_legend(registry_or_collection, settings: dict, placement: Matrix, widt
     quads = np.stack([idx, idx + 1, idx + n + 2, idx + n + 1], -1)
     lo, hi = settings["limits"]
     values = np.tile(lo + (hi - lo) * x / width, 2)
-    colours = diverging_colours(values, (lo, hi))
+    colours = colours_for(values, (lo, hi), settings.get("quantity", "mean"))
     objects = []
 
     def obtain(key, name, new_data):
@@ -339,7 +361,9 @@ def build_legend(registry_or_collection, settings: dict, placement: Matrix, widt
     size = LEGEND_TEXT_SIZE * width
     texts = [(title, Matrix.Translation((0.0, h + 0.35 * size, 0.0)))]
     for t, label in ticks:
-        texts.append((label, Matrix.Translation((t * width - 0.27 * size * len(label), -1.0 * size, 0.0))))
+        x = t * width - 0.27 * size * len(label)  # centred on its tick, kept inside the bar's ends
+        x = min(max(x, 0.0), width - 0.54 * size * len(label))
+        texts.append((label, Matrix.Translation((x, -1.0 * size, 0.0))))
     for i, (body, offset) in enumerate(texts):
         obj = obtain((tag, "text", i), f"Review legend text {i}", None if registry else (lambda nm: None))
         if obj.type != "MESH" or obj.data is None:
@@ -413,6 +437,7 @@ class ReviewOptions:
     legend: bool = True
     reference: str = ""
     spacing: float = 0.0
+    include_hub: bool = False
 
 
 @dataclass
@@ -422,6 +447,31 @@ class ReviewResult:
     numbers: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
     times: dict = field(default_factory=dict)
+
+
+def colours_for(values, limits, quantity: str) -> np.ndarray:
+    """sRGB RGBA of ``values``: sequential from 0 for quantities that are never negative,
+    black and white stripes for zebra, diverging about 0 otherwise."""
+    if quantity == "zebra":
+        return zebra_colours(values)
+    if quantity in NON_NEGATIVE:
+        return sequential_colours(values, limits)
+    return diverging_colours(values, limits)
+
+
+def is_hub(obj) -> bool:
+    """A propeller's hub (or hub sector): excluded from the colour limits by default, its
+    curvature (nose, tail) would set them and wash the blade out."""
+    return obj is not None and obj.get("bladesmith_part") == "hub"
+
+
+def _zebra_frame(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(view direction, stripe axis) for zebra stripes over all reviewed points: looking
+    along the direction of smallest extent; the stripe axis is the middle one (a blade's
+    chord, across which its normals turn), so the stripes run along the largest (span)."""
+    centre = points.mean(axis=0)
+    _, _, Vt = np.linalg.svd(points - centre, full_matrices=False)
+    return -Vt[2], Vt[1]
 
 
 def _geometry(obj):
@@ -458,16 +508,37 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
             if isinstance(entity, BSplineSurface):
                 if entity.dim != 3:
                     continue
-                m = surface_map(entity, opt.quantity, opt.samples_per_span, sign)
+                m = surface_map(entity, "mean" if opt.quantity == "zebra" else opt.quantity, opt.samples_per_span, sign)
                 computed.append((role, owner, objs, entity, index, m))
             elif isinstance(entity, BSplineCurve) and role == "source":
                 computed.append((role, owner, objs, entity, index, None))
     times["maps"] = time.perf_counter() - clock
+    if opt.quantity == "zebra" and any(c[5] is not None for c in computed):
+        from dataclasses import replace
+
+        pts = np.concatenate([c[5].points.reshape(-1, 3) @ np.array(c[1].matrix_world)[:3, :3].T for c in computed
+                              if c[5] is not None])
+        view, axis = _zebra_frame(pts)
+        for k, c in enumerate(computed):
+            if c[5] is None:
+                continue
+            R = np.array(c[1].matrix_world)[:3, :3]
+            normals = c[5].curvature.normal @ R.T
+            normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+            computed[k] = c[:5] + (replace(c[5], values=zebra_values(normals, view, axis), quantity="zebra"),)
     maps = [c for c in computed if c[5] is not None]
-    values = [c[5].values for c in maps]
+    # the hub's curvature (nose, tail, fillets) would set the limits: leave it out of them
+    counted = [c for c in maps if opt.include_hub or not is_hub(c[1])] or maps
+    excluded = sorted({c[1].name for c in maps if c not in counted})
+    values = [c[5].values for c in counted]
     if values:
-        areas = [c[5].vertex_areas() for c in maps]
-        limits = (-opt.limit, opt.limit) if opt.limit > 0 else symmetric_limits(values, opt.percentile, areas)
+        areas = [c[5].vertex_areas() for c in counted]
+        if opt.quantity == "zebra":
+            limits = (0.0, 1.0)
+        elif opt.quantity in NON_NEGATIVE:
+            limits = (0.0, opt.limit) if opt.limit > 0 else upper_limit(values, opt.percentile, areas)
+        else:
+            limits = (-opt.limit, opt.limit) if opt.limit > 0 else symmetric_limits(values, opt.percentile, areas)
         v_all = np.concatenate([v.ravel() for v in values])
         a_all = np.concatenate([a.ravel() for a in areas])
         outside = (v_all < limits[0]) | (v_all > limits[1])
@@ -520,13 +591,20 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
     result = ReviewResult(settings={"quantity": opt.quantity, "limits": list(limits), "percentile": opt.percentile
                                     if opt.limit <= 0 else 100.0, "clipped": clipped, "sign": sign,
                                     "comb_scale": scale, "sources": [s.name for s in sources],
-                                    "reference": opt.reference})
+                                    "reference": opt.reference, "excluded_from_limits": excluded,
+                                    "samples_per_span": opt.samples_per_span,
+                                    "sign_convention": sign_convention(opt.quantity, opt.convex_positive)})
     shift = {"source": Vector((0.0, 0.0, 0.0)), "reference": Vector((-spacing, 0.0, 0.0))}
+    result.settings["spacing"] = spacing
+    # one colour scale for every deviation map, so they compare with each other
+    dlim = symmetric_limits(list(deviation.values()), 100.0) if deviation else None
+    if dlim is not None:
+        result.settings["deviation_limits"] = list(dlim)
     for role, owner, objs, entity, index, m in maps:
         offset = DISPLAY_OFFSET_FRACTION * max(entity.size(), 1e-12)
         verts = (m.points + offset * m.curvature.normal).reshape(-1, 3)
         quads = m.quads()
-        colours = diverging_colours(m.values.ravel(), limits)
+        colours = colours_for(m.values.ravel(), limits, opt.quantity)
         first = None
         for k, obj in enumerate(objs):
             name = f"{obj.name} map" + (f" {index}" if index else "")
@@ -548,7 +626,6 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
             result.maps.append(target)
         dev = deviation.get((owner.name, index))
         if dev is not None:
-            dlim = symmetric_limits(dev, 100.0)
             target = registry.get(("deviation", owner.name, index), "MESH", f"{owner.name} deviation", _new_mesh)
             _write_mesh(target.data, verts, quads, diverging_colours(dev.ravel(), dlim), dev.ravel())
             target["bladesmith_deviation_limits"] = list(dlim)
@@ -653,7 +730,7 @@ def _orthonormal_views(P: np.ndarray, span: np.ndarray, side: np.ndarray, names)
     ext_s, ext_c = np.ptp(proj_s), np.ptp(proj_c)
     mid = span * 0.5 * (proj_s.max() + proj_s.min()) + chord * 0.5 * (proj_c.max() + proj_c.min())
     mid = mid + side * np.mean(P @ side)
-    scale = 1.1 * max(ext_s, ext_c)
+    scale = 1.3 * max(ext_s, ext_c)  # room for the LE/TE/root/tip labels outside the blade
     dist = 4.0 * scale
     tip_point = P[np.argmax(proj_s)]
     tip_centre = tip_point - span * 0.12 * ext_s
@@ -662,7 +739,8 @@ def _orthonormal_views(P: np.ndarray, span: np.ndarray, side: np.ndarray, names)
     return [
         {"title": names[0], "matrix": _look_at(mid + side * dist, mid, span), "ortho_scale": scale},
         {"title": names[1], "matrix": _look_at(mid - side * dist, mid, span), "ortho_scale": scale},
-        {"title": "tip close-up", "matrix": _look_at(tip_centre + tip_dir * dist, tip_centre, span),
+        {"title": "tip close-up" if names[0] == "pressure side" else "close-up (far end)",
+         "matrix": _look_at(tip_centre + tip_dir * dist, tip_centre, span),
          "ortho_scale": 0.4 * max(ext_s, ext_c)},
     ]
 
@@ -738,10 +816,180 @@ def _write_png(pixels: np.ndarray, path: str) -> None:
         bpy.data.images.remove(img)
 
 
+def _propeller_edges(maps) -> dict:
+    """World positions of a Bladesmith propeller blade's LE and TE at mid-span, from its
+    first surface (patch 0 of blade 0: the smoothed blade's pressure_central, or the whole
+    unsmoothed blade): u runs along +ξ from the trailing edge (ξ = 0) to the leading edge
+    (ξ = 1/2) on either hand (geometry/propeller/blade.py)."""
+    for obj in maps:
+        src = _source_of(obj)
+        if src is None or src.get("bladesmith_part") != "blade" or src.get("bladesmith_patch") != 0 \
+                or int(src.get("bladesmith_blade", 0)) != 0:
+            continue
+        surfaces = [e for e in object_to_geometry(src) if isinstance(e, BSplineSurface)]
+        if not surfaces:
+            return {}
+        S = surfaces[0]
+        (u0, u1), (v0, v1) = S.domain_u, S.domain_v
+        v = 0.5 * (v0 + v1)
+        M = np.array(src.matrix_world)
+        pts = np.array([S.evaluate(u1, v), S.evaluate(u0, v)]).reshape(2, -1)[:, :3]
+        if np.linalg.norm(pts[0] - pts[1]) <= 1e-9 * max(S.size(), 1e-12):
+            # the unsmoothed blade is one surface around the section, TE -> LE (ξ = 1/2) -> TE
+            pts[0] = np.asarray(S.evaluate(0.5 * (u0 + u1), v)).reshape(-1)[:3]
+        world = pts @ M[:3, :3].T + M[:3, 3]
+        return {"LE": world[0], "TE": world[1]}
+    return {}
+
+
+def _source_of(obj):
+    key = _role(obj)
+    return bpy.data.objects.get(key[2]) if key and key[0] == "map" else None
+
+
+def _root_of(obj):
+    while obj is not None and obj.parent is not None:
+        obj = obj.parent
+    return obj
+
+
+def default_title(maps) -> str:
+    """The reviewed objects: their roots' names (a propeller, a wind blade, an impeller)."""
+    roots = []
+    for m in maps:
+        root = _root_of(_source_of(m))
+        if root is not None and root.name not in roots:
+            roots.append(root.name)
+    return ", ".join(roots[:4]) + (f" and {len(roots) - 4} more" if len(roots) > 4 else "")
+
+
+def _settings_line(settings: dict) -> str:
+    name, units = LABELS.get(settings["quantity"], (settings["quantity"], ""))
+    lo, hi = settings["limits"]
+    parts = [f"{name}", f"colour limits [{lo:.3g}, {hi:.3g}] {units}" if settings["quantity"] != "zebra" else "",
+             "" if settings["quantity"] == "zebra" else
+             f"{settings['percentile']:g}th area percentile" if settings.get("percentile", 100) < 100 else "fixed limits",
+             f"{settings.get('samples_per_span', DEFAULT_SAMPLES_PER_SPAN)} samples per knot span"]
+    if settings.get("excluded_from_limits"):
+        parts.append("hub not counted in the limits (and not drawn)")
+    return "; ".join(p for p in parts if p)
+
+
+def _wind_views(maps, panel_px: int) -> list[dict] | None:
+    """A long blade (span over 3 chords) in span segments, per side: each segment a strip
+    that fills the image's width, span running left (root) to right (tip)."""
+    P, _, means = _map_points(maps)
+    centre = P.mean(axis=0)
+    _, sv, Vt = np.linalg.svd(P - centre, full_matrices=False)
+    span, side = Vt[0], Vt[2]
+    chord = np.cross(side, span)
+    ps, pc = P @ span, P @ chord
+    # root to the left: the root is the thicker end (largest extent along side)
+    ends = [np.ptp((P @ side)[np.abs(ps - e) < 0.05 * np.ptp(ps)]) for e in (ps.min(), ps.max())]
+    if ends[1] > ends[0]:
+        span, chord = -span, -chord
+        ps, pc = -ps, -pc
+    count = segment_count(float(np.ptp(ps)), float(np.ptp(pc)))
+    if count < 2:
+        return None
+    segments = span_segments(P, span, count)
+    width_px = 3 * panel_px
+    views = []
+    for side_sign, name in ((1.0, "side A"), (-1.0, "side B")):
+        # name the side after the mould part that faces the camera (outward normals)
+        facing = [(float(np.dot(m, side_sign * side)), _source_of(o)) for o, m in zip(maps, means)]
+        best = max(facing, key=lambda f: f[0])[1] if facing else None
+        if best is not None and best.get("bladesmith_mold_part"):
+            name = f"{str(best['bladesmith_mold_part']).replace('_', ' ')} side"
+        for k, (a, b) in enumerate(segments):
+            length = (b - a) * 1.04
+            mid_s = 0.5 * (a + b)
+            in_seg = (ps >= a) & (ps <= b)
+            c_lo, c_hi = pc[in_seg].min(), pc[in_seg].max()
+            height = max(c_hi - c_lo, 1e-9) * 1.25
+            target = span * mid_s + chord * 0.5 * (c_lo + c_hi) + side * float(np.mean(P @ side))
+            height_px = int(np.clip(round(width_px * height / length), 60, width_px))
+            dist = 4.0 * length
+            views.append({"title": f"{name}, span {k + 1}/{count}" if k == 0 else f"span {k + 1}/{count}",
+                          # up = ±chord keeps the root on the left seen from either side
+                          "matrix": _look_at(target + side_sign * side * dist, target, side_sign * chord),
+                          "ortho_scale": length,
+                          "resolution": (width_px, height_px), "span": span, "side": side * side_sign,
+                          "row": True})
+    return views
+
+
+def _overlay_objects(view, landmarks: dict, centre: np.ndarray, made_meshes: list, tag: str) -> list:
+    """Text and scale bar objects for one panel: the view's title, LE/TE/root/tip labels
+    and a scale bar, all in the camera's plane in front of the maps."""
+    M = np.array(view["matrix"])
+    right, up, back = M[:3, 0], M[:3, 1], M[:3, 2]
+    res_x, res_y = view.get("resolution", (1, 1))
+    s = view["ortho_scale"]
+    half_w = 0.5 * s
+    half_h = half_w * res_y / res_x
+    size = 0.013 * s if view.get("row") else 0.05 * s  # the same height in pixels on every strip
+    cam_pos = M[:3, 3]
+    cam_centre = cam_pos - back * np.dot(cam_pos - centre, back)  # the view centre in the map's depth
+    front = back * (0.5 * s)
+
+    def placed(anchor, dx=0.0, dy=0.0):
+        R = Matrix(M)
+        p = anchor + front + right * dx + up * dy
+        R[0][3], R[1][3], R[2][3] = p
+        return R
+
+    out = []
+
+    def text(body, anchor, dx, dy, name):
+        mesh = _text_mesh(body, f"{tag} {name}", size)
+        made_meshes.append(mesh)
+        obj = bpy.data.objects.new(f"{tag} {name}", mesh)
+        obj.matrix_world = placed(anchor, dx, dy)
+        out.append(obj)
+
+    text(view["title"], cam_centre, -half_w + 0.03 * s, half_h - 1.4 * size, "title")
+    for name, point in landmarks.items():
+        d = point - centre
+        screen = np.array([np.dot(d, right), np.dot(d, up)])
+        n = np.linalg.norm(screen)
+        screen = screen / n if n > 0 else np.array([0.0, 1.0])
+        offset = screen * 2.2 * size
+        if name == "tip" and not view.get("row"):
+            offset = np.array([1.0 * size, 0.4 * size])  # beside the tip, clear of the panel's title
+            text(name, point, offset[0], offset[1], name)
+            continue
+        text(name, point, offset[0] - 0.3 * size * len(name), offset[1] - 0.35 * size, name)
+    # scale bar in the lower left corner
+    length = nice_length(0.22 * 2 * half_w)
+    bar_h = 0.18 * size
+    x0 = -half_w + 0.04 * s
+    y0 = -half_h + 0.6 * size
+    verts = np.array([[0, 0, 0], [length, 0, 0], [length, bar_h, 0], [0, bar_h, 0]], dtype=np.float64)
+    mesh = bpy.data.meshes.new(f"{tag} scale bar")
+    made_meshes.append(mesh)
+    black = np.tile([0.0, 0.0, 0.0, 1.0], (4, 1))
+    _write_mesh(mesh, verts, np.array([[0, 1, 2, 3]]), black)
+    bar = bpy.data.objects.new(f"{tag} scale bar", mesh)
+    bar.matrix_world = placed(cam_centre, x0, y0)
+    out.append(bar)
+    text(length_label(length), cam_centre, x0, y0 + bar_h + 0.25 * size, "scale label")
+    return out
+
+
 def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend_height: int = 150,
-                        scene=None, review: bool = True, samples: str = "FXAA", **review_options) -> dict:
-    """Write a PNG with three Workbench views (pressure side, suction side, tip close-up)
-    of the curvature maps of ``objects`` and a legend strip below them.
+                        scene=None, review: bool = True, samples: str = "8", title: str = "",
+                        **review_options) -> dict:
+    """Write a PNG review image of the curvature maps of ``objects``.
+
+    Top: a title strip (``title``, default the reviewed roots' names; the quantity, colour
+    limits, percentile and sampling; its sign convention; what the thin grey lines are).
+    Middle: Workbench views with LE/TE/root/tip labels (blades) and a scale bar each:
+    pressure side, suction side and tip close-up for a propeller blade, front, back and
+    a close-up otherwise; a blade longer than three chords (a wind blade) is drawn in
+    span segments stacked as strips that fill the width. With a reference (the review's
+    ``reference``) every view shows before | after | deviation side by side, before and
+    after on the same colour limits. Bottom: the legend(s).
 
     ``review``: run :func:`review_objects` first (with ``review_options``), else use the
     maps already in the review collection. The render happens in a temporary scene that
@@ -757,11 +1005,43 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
     if coll is None:
         raise GeometryError("no curvature review to render: run the review first")
     settings = json.loads(coll.get(SETTINGS_KEY, "{}"))
-    maps = [o for o in coll.objects if (_role(o) or ("",))[0] == "map" and _role(o)[1] == "source"]
+    roles = [(o, _role(o) or ("",)) for o in coll.objects]
+    maps = [o for o, r in roles if r[0] == "map" and r[1] == "source"]
     if not maps:
         raise GeometryError("the review has no surface maps to render")
+    # a propeller's hub is not drawn when it does not count for the limits: clipped, it
+    # would only hide the blade root
+    hub_hidden = bool(settings.get("excluded_from_limits"))
+    if hub_hidden:
+        maps = [o for o in maps if not is_hub(_source_of(o))] or maps
+    # a propeller's other blades are linked copies of the reference blade: same colours,
+    # and in the framed views they would only cover its root
+    maps = [o for o in maps if _source_of(o) is None or int(_source_of(o).get("bladesmith_blade", 0)) == 0] or maps
+    before = [o for o, r in roles if r[0] == "map" and r[1] == "reference"]
+    after_dev = [o for o, r in roles if r[0] == "deviation"]
+    columns = [("", maps, 0.0)]
+    if hub_hidden:
+        before = [o for o in before if not is_hub(_source_of(o))]
+    if before and after_dev:
+        spacing = float(settings.get("spacing", 0.0))
+        columns = [("before", before, -spacing), ("after", maps, 0.0), ("deviation", after_dev, spacing)]
     times["review"] = time.perf_counter() - clock
-    views = review_views(maps)
+    framed = [o for o in maps if not is_hub(_source_of(o))] or maps
+    wind = any(_source_of(o) is not None and _source_of(o).get("bladesmith_mold_part") is not None for o in maps)
+    views = _wind_views(framed, panel_size) if wind else None
+    if views is None:
+        views = review_views(maps)
+        if len(columns) > 1:
+            views = views[:2]  # pressure and suction sides (or front and back), each before | after | deviation
+    # landmarks of the reference blade only (a propeller's copies are rendered, not labelled)
+    blade0 = [o for o in framed if _source_of(o) is not None and int(_source_of(o).get("bladesmith_blade", 0)) == 0]
+    P, _, _ = _map_points(blade0 or framed)
+    # labels only where root, tip and the edges are known to mean what they say: a wind
+    # blade or a propeller blade (an impeller blade's hub and shroud edges are not a root
+    # and a tip along one axis)
+    blade_like = wind or any(
+        _source_of(o) is not None and _source_of(o).get("bladesmith_part") == "blade" for o in maps)
+    propeller_edges = _propeller_edges(maps)
     made_objects, made_meshes = [], []
     temp = bpy.data.scenes.new("Bladesmith review render")
     world = bpy.data.worlds.new("Bladesmith review world")
@@ -772,14 +1052,14 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
         temp.world = world
         temp.render.engine = "BLENDER_WORKBENCH"
         shading = temp.display.shading
-        # flat light keeps the map's colours true to the legend; outline and cavity
-        # (ridges and valleys) give the shape
+        # flat light keeps the map's colours true to the legend; the outline draws the
+        # surfaces' (patches') boundaries. No cavity: its screen-space sampling is what
+        # speckled the earlier images.
         shading.light = "FLAT"
         shading.color_type = "VERTEX"
         shading.show_object_outline = True
-        shading.object_outline_color = (0.1, 0.1, 0.1)
-        shading.show_cavity = True
-        shading.cavity_type = "WORLD"
+        shading.object_outline_color = (0.35, 0.35, 0.35)
+        shading.show_cavity = False
         temp.display.render_aa = samples
         temp.view_settings.view_transform = "Standard"
         temp.view_settings.look = "None"
@@ -787,60 +1067,119 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
         temp.render.image_settings.file_format = "PNG"
         temp.render.image_settings.color_mode = "RGB"
         temp.render.resolution_percentage = 100
-        for obj in maps:
-            copy = bpy.data.objects.new(obj.name + " render", obj.data)
-            copy.matrix_world = obj.matrix_world
-            temp.collection.objects.link(copy)
-            made_objects.append(copy)
         cam = bpy.data.objects.new("Bladesmith review camera", camera_data)
         temp.collection.objects.link(cam)
         made_objects.append(cam)
         temp.camera = cam
         camera_data.type = "ORTHO"
-        temp.render.resolution_x = temp.render.resolution_y = int(panel_size)
-        panels = []
-        title_obj = None
+        copies = {}
+        for _, group, _ in columns:
+            for obj in group:
+                if obj.name not in copies:
+                    copy = bpy.data.objects.new(obj.name + " render", obj.data)
+                    copy.matrix_world = obj.matrix_world
+                    made_objects.append(copy)
+                    copies[obj.name] = copy
+
+        def clear_scene():
+            for obj in list(temp.collection.objects):
+                if obj is not cam:
+                    temp.collection.objects.unlink(obj)
+
+        rows = []  # each a list of panels (h, w, 4), drawn top to bottom
+        # square views side by side in one row; strips (segments) or comparisons one row each
+        one_row = not views[0].get("row") and len(columns) == 1
         for i, view in enumerate(views):
-            cam.matrix_world = view["matrix"]
+            res_x, res_y = view.get("resolution", (panel_size, panel_size))
+            if len(columns) > 1 and view.get("row"):
+                res_x //= len(columns)
+                res_y = max(60, int(res_y / len(columns)))
+            view = dict(view, resolution=(res_x, res_y))
+            temp.render.resolution_x, temp.render.resolution_y = res_x, res_y
             s = view["ortho_scale"]
             camera_data.ortho_scale = s
             camera_data.clip_start = 1e-3 * s
             camera_data.clip_end = 100.0 * s
-            if title_obj is not None:
-                temp.collection.objects.unlink(title_obj)
-            mesh = _text_mesh(view["title"], f"Bladesmith review title {i}", 0.055 * s)
-            made_meshes.append(mesh)
-            title_obj = bpy.data.objects.new(f"Bladesmith review title {i}", mesh)
-            made_objects.append(title_obj)
-            title_obj.matrix_world = view["matrix"] @ Matrix.Translation((-0.46 * s, 0.42 * s, -0.05 * s))
-            temp.collection.objects.link(title_obj)
-            path = os.path.join(folder, f"view{i}.png")
-            _render(temp, path)
-            panels.append(_read_png(path))
+            span = view.get("span")
+            if span is None:
+                M = np.array(view["matrix"])
+                span, side = M[:3, 1], M[:3, 2]
+            else:
+                side = view["side"]
+            landmarks = blade_landmarks(P, span, side) if blade_like else {}
+            if landmarks:
+                landmarks.update(propeller_edges)
+            centre = P.mean(axis=0)
+            panels = []
+            for c, (label, group, dx) in enumerate(columns):
+                clear_scene()
+                shift = np.array([dx, 0.0, 0.0])
+                for obj in group:
+                    temp.collection.objects.link(copies[obj.name])
+                panel_view = dict(view, title=(f"{view['title']}: {label}" if label else view["title"]),
+                                  matrix=Matrix.Translation(shift) @ view["matrix"])
+                overlays = _overlay_objects(panel_view, {k: v + shift for k, v in landmarks.items()}, centre + shift,
+                                            made_meshes, f"Bladesmith review {i}.{c}")
+                for obj in overlays:
+                    temp.collection.objects.link(obj)
+                made_objects.extend(overlays)
+                cam.matrix_world = panel_view["matrix"]
+                path = os.path.join(folder, f"view{i}_{c}.png")
+                _render(temp, path)
+                panels.append(_read_png(path))
+            if one_row and rows:
+                rows[0].extend(panels)
+            else:
+                rows.append(panels)
         times["views"] = time.perf_counter() - clock - times["review"]
-        # legend strip: its own small render, far from the maps
-        for obj in list(temp.collection.objects):
-            if obj is not cam:
-                temp.collection.objects.unlink(obj)
+        # legend(s) and title strip: their own small renders, far from the maps
+        total_w = max(sum(p.shape[1] for p in row) for row in rows)
+        # the sign convention is in the heading; the legend keeps name, units and limits
+        legends = [{k: v for k, v in settings.items() if k != "sign_convention"}]
+        if len(columns) > 1 and settings.get("deviation_limits"):
+            legends.append({"quantity": "deviation", "limits": settings["deviation_limits"], "percentile": 100.0,
+                            "sign_convention": "positive: outside the reference"})
+        strips = []
         width = 1.0
-        legend_objs = build_legend(temp.collection, settings, Matrix.Identity(4), width, tag="render legend")
-        made_objects.extend(legend_objs)
-        made_meshes.extend(o.data for o in legend_objs)
-        total_w = panel_size * len(views)
-        temp.render.resolution_x = total_w
-        temp.render.resolution_y = int(legend_height)
-        shading.light = "FLAT"  # the bar shows the map's colours exactly
-        s = max(1.12 * width, (LEGEND_BELOW + LEGEND_ABOVE) * width * 1.15 * total_w / legend_height)
-        camera_data.ortho_scale = s
-        centre = np.array([0.5 * width, 0.5 * (LEGEND_ABOVE - LEGEND_BELOW) * width, 0.0])
-        cam.matrix_world = _look_at(centre + np.array([0.0, 0.0, 2.0]), centre, np.array([0.0, 1.0, 0.0]))
-        camera_data.clip_start, camera_data.clip_end = 1e-3, 10.0
-        path = os.path.join(folder, "legend.png")
-        _render(temp, path)
-        legend = _read_png(path)
-        image = np.concatenate([legend, np.concatenate(panels, axis=1)], axis=0)  # rows run bottom-up
-        for k in range(1, len(views)):  # thin separators between the panels
-            image[legend.shape[0]:, k * panel_size - 1 : k * panel_size + 1, :3] = 0.6
+        for k, legend_settings in enumerate(legends):
+            clear_scene()
+            legend_objs = build_legend(temp.collection, legend_settings, Matrix.Identity(4), width,
+                                       tag=f"render legend {k}")
+            made_objects.extend(legend_objs)
+            made_meshes.extend(o.data for o in legend_objs)
+            strips.append(_render_strip(temp, cam, camera_data, folder, f"legend{k}", total_w, int(legend_height),
+                                        (LEGEND_BELOW + LEGEND_ABOVE) * width, 1.12 * width,
+                                        np.array([0.5 * width, 0.5 * (LEGEND_ABOVE - LEGEND_BELOW) * width, 0.0])))
+        clear_scene()
+        lines = [title or default_title(maps) or "curvature review", _settings_line(settings),
+                 f"{settings.get('sign_convention', '')}" + ("; " if settings.get("sign_convention") else "")
+                 + "grey lines: edges of the NURBS surfaces"]
+        text_h = 0.03
+        for n, body in enumerate(lines):
+            mesh = _text_mesh(body, f"Bladesmith review heading {n}", text_h * (1.25 if n == 0 else 1.0))
+            made_meshes.append(mesh)
+            obj = bpy.data.objects.new(f"Bladesmith review heading {n}", mesh)
+            obj.matrix_world = Matrix.Translation((0.0, -1.6 * text_h * n, 0.0))
+            temp.collection.objects.link(obj)
+            made_objects.append(obj)
+        heading_h = int(legend_height * 0.9)
+        heading = _render_strip(temp, cam, camera_data, folder, "heading", total_w, heading_h,
+                                5.0 * text_h, 1.12 * width, np.array([0.5 * width, -1.2 * text_h, 0.0]),
+                                left_align=True)
+        body_rows = []
+        for panels in rows:
+            row = np.concatenate(panels, axis=1)
+            if row.shape[1] < total_w:
+                pad = np.ones((row.shape[0], total_w - row.shape[1], 4), dtype=row.dtype)
+                row = np.concatenate([row, pad], axis=1)
+            x = 0
+            for p in panels[:-1]:  # thin separators between the panels
+                x += p.shape[1]
+                row[:, x - 1 : x + 1, :3] = 0.6
+            row[:2, :, :3] = 0.6
+            body_rows.append(row)
+        # image rows run bottom-up: legends, the views (last view lowest), heading on top
+        image = np.concatenate(list(reversed(strips)) + list(reversed(body_rows)) + [heading], axis=0)
         _write_png(image, filepath)
         times["legend_and_write"] = time.perf_counter() - clock - times["review"] - times["views"]
     finally:
@@ -858,6 +1197,22 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
         os.rmdir(folder)
     times["total"] = time.perf_counter() - clock
     return {"filepath": filepath, "views": [v["title"] for v in views], "times": times}
+
+
+def _render_strip(temp, cam, camera_data, folder, name, width_px, height_px, content_h, content_w, centre,
+                  left_align: bool = False):
+    """Render what is in ``temp`` around ``centre`` (the xy plane) into a strip of the
+    image's width; ``left_align``: x = 0 near the strip's left edge instead."""
+    temp.render.resolution_x, temp.render.resolution_y = int(width_px), int(height_px)
+    temp.display.shading.light = "FLAT"
+    camera_data.ortho_scale = max(content_w, content_h * 1.15 * width_px / height_px)
+    if left_align:
+        centre = np.array([0.48 * camera_data.ortho_scale, centre[1], centre[2]])
+    cam.matrix_world = _look_at(centre + np.array([0.0, 0.0, 2.0]), centre, np.array([0.0, 1.0, 0.0]))
+    camera_data.clip_start, camera_data.clip_end = 1e-3, 10.0
+    path = os.path.join(folder, f"{name}.png")
+    _render(temp, path)
+    return _read_png(path)
 
 
 # ---------------------------------------------------------------------------------------
@@ -888,6 +1243,9 @@ class BLADESMITH_OT_curvature_review(bpy.types.Operator):
     comb_inside: BoolProperty(name="Teeth Inside", default=False,
                               description="Draw teeth towards the centre of curvature (default: convex side)")
     envelope: BoolProperty(name="Envelope", default=True)
+    include_hub: BoolProperty(name="Hub in Limits", default=False,
+                              description="Let a propeller hub's curvature count for the colour limits "
+                                          "(off: the blade sets them, the hub is clipped)")
     iso_lines: IntProperty(name="Counted Iso Lines", default=11, min=0, max=200)
     reference: StringProperty(name="Reference", default="",
                               description="Object or collection before smoothing: same limits, and a difference map")
@@ -904,7 +1262,7 @@ class BLADESMITH_OT_curvature_review(bpy.types.Operator):
             samples_per_span=self.samples_per_span, convex_positive=self.convex_positive,
             comb_lines=self.comb_lines, comb_teeth=self.comb_teeth, comb_scale=self.comb_scale,
             comb_sign=-1.0 if self.comb_inside else 1.0, envelope=self.envelope, iso_lines=self.iso_lines,
-            reference=self.reference,
+            reference=self.reference, include_hub=self.include_hub,
         )
         wm = context.window_manager
         wm.progress_begin(0, 2)

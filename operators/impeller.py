@@ -20,7 +20,7 @@ import numpy as np
 from bpy.props import BoolProperty, EnumProperty, StringProperty
 
 from ..geometry.compressor import ImpellerDefinition, blade_net, distribution, dumps_toml
-from ..geometry.compressor.export import impeller_surfaces
+from ..geometry.compressor.export import construction_summary, impeller_surfaces
 from ..geometry.errors import BladesmithError, DefinitionError
 from .nurbs_objects import PROPERTY_KEY, remove_object, surface_to_object, write_surface
 
@@ -39,12 +39,21 @@ def _preset_items(self, context):
     return [(n, n.replace("_", " "), f"data/impellers/{n}.toml") for n in preset_names()]
 
 
+def preset_file(name: str) -> pathlib.Path:
+    """The definition file of a preset, matched without regard to case, as the propeller
+    and wind-blade presets are ("HIGH_FLOW", "High_Flow" and "high_flow.toml" all work)."""
+    key = str(name).strip().lower()
+    if key.endswith(".toml"):
+        key = key[: -len(".toml")]
+    if key not in preset_names():
+        raise DefinitionError(f"unknown preset {name!r}; available: {', '.join(preset_names())}", field="preset")
+    return PRESET_DIR / f"{key}.toml"
+
+
 def load_definition(definition: str = "", preset: str = "") -> ImpellerDefinition:
     if definition:
         return ImpellerDefinition.from_toml(bpy.path.abspath(definition))
-    if preset not in preset_names():
-        raise DefinitionError(f"unknown preset {preset!r}; available: {', '.join(preset_names())}", field="preset")
-    return ImpellerDefinition.from_toml(PRESET_DIR / f"{preset}.toml")
+    return ImpellerDefinition.from_toml(preset_file(preset))
 
 
 def net_to_mesh(net: np.ndarray, name: str, collection):
@@ -132,7 +141,12 @@ class BLADESMITH_OT_add_impeller(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     definition: StringProperty(name="Definition", description="Impeller TOML file", subtype="FILE_PATH", default="")
-    preset: EnumProperty(name="Preset", items=_preset_items)
+    preset: StringProperty(
+        name="Preset name",
+        description="Preset, by name without regard to case (e.g. high_flow); used when no definition is given",
+        default="high_flow",
+    )
+    preset_choice: EnumProperty(name="Preset", description="Preset, chosen from the list", items=_preset_items)
     full_wheel: BoolProperty(name="Full Wheel", description="All Z blades (and splitters), not only the first", default=True)
     blade_net: BoolProperty(name="Blade Net", description="Add the (u, v) net of the camber surface as a mesh", default=False)
 
@@ -140,9 +154,15 @@ class BLADESMITH_OT_add_impeller(bpy.types.Operator):
     def poll(cls, context):
         return context.mode == "OBJECT"
 
+    def _preset_name(self) -> str:
+        # a script names `preset`; the redo panel's list sets `preset_choice`
+        if self.properties.is_property_set("preset") or not self.properties.is_property_set("preset_choice"):
+            return self.preset
+        return self.preset_choice
+
     def execute(self, context):
         try:
-            definition = load_definition(self.definition, self.preset)
+            definition = load_definition(self.definition, self._preset_name())
             model = definition.build()  # validate before touching the scene
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
@@ -159,15 +179,18 @@ class BLADESMITH_OT_add_impeller(bpy.types.Operator):
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         summary = "" if model.standardisation is None else model.standardisation.summary()
+        construction, met = construction_summary(model)
         settings = getattr(root, "bladesmith_impeller", None)
         if settings is not None:
-            settings.load(definition, self.full_wheel, summary)
+            settings.load(definition, self.full_wheel, summary, construction)
         for obj in context.view_layer.objects:
             obj.select_set(False)
         root.select_set(True)
         context.view_layer.objects.active = root
         if summary:
             self.report({"INFO"}, f"{definition.name}: {summary}")
+        if construction:
+            self.report({"INFO"} if met else {"WARNING"}, f"{definition.name}: {construction}")
         return {"FINISHED"}
 
 

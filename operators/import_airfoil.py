@@ -19,7 +19,8 @@ from bpy_extras.io_utils import ImportHelper
 from ..geometry.errors import BladesmithError
 from ..geometry.nurbs import interpolate
 from ..geometry.sections.airfoil_file import read_airfoil
-from .nurbs_objects import curve_to_object
+from .hvid_properties import JOBCARD, HvidProperties, draw_jobcard
+from .nurbs_objects import curve_to_object, remove_object
 
 #: Custom property holding the tabulated, unit-chord airfoil on imported objects.
 AIRFOIL_KEY = "bladesmith_airfoil"
@@ -62,7 +63,7 @@ def stored_airfoil(obj) -> tuple[np.ndarray, float] | None:
     return points, float(record["chord"])
 
 
-class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper):
+class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper, HvidProperties):
     """Import an airfoil coordinate file (Selig, reverse Selig or Lednicer .dat) as a curve at unit chord"""
 
     bl_idname = "bladesmith.import_airfoil"
@@ -80,6 +81,20 @@ class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper):
         default=False,
     )
 
+    smooth: BoolProperty(
+        name="Smooth (Hvid)",
+        description="Smooth the imported airfoil with Hvid's smoothfoil (the settings below), as Smooth Curve (Hvid) does",
+        default=False,
+    )
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "chord")
+        layout.prop(self, "as_polyline")
+        layout.prop(self, "smooth")
+        if self.smooth:
+            draw_jobcard(layout.box(), self, "AIRFOIL", show_kind=False)
+
     def execute(self, context):
         try:
             airfoil = read_airfoil(self.filepath)
@@ -87,10 +102,21 @@ class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper):
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
-        for other in context.selected_objects:
+        selected = list(context.selected_objects)
+        for other in selected:
             other.select_set(False)
         obj.select_set(True)
         context.view_layer.objects.active = obj
+        if self.smooth:
+            jobcard = {name: getattr(self, name) for name in JOBCARD if name != "kind"}
+            try:
+                bpy.ops.bladesmith.smooth_curve(kind="AIRFOIL", **jobcard)
+            except RuntimeError as exc:  # the smoother's own refusal, reported as an error
+                remove_object(obj)
+                for other in selected:
+                    other.select_set(True)
+                self.report({"ERROR"}, f"{self.filepath}: not imported, the smoothing failed: {exc}")
+                return {"CANCELLED"}
         te = airfoil.trailing_edge_thickness
         self.report(
             {"INFO"},

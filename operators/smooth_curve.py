@@ -12,22 +12,22 @@ operator adds, in a collection "<name> fairing":
 - "<name> comb": a curvature comb on the smoothed curve;
 - "<name> deviation": the deviation of Fig. 3.4, magnified, against normalised arc length.
 
-Property names spell out the jobcard's (Hvid 1993, Appendix / §3.4): ``output_points`` =
-np, ``smoothing_points`` = nsmooth, ``max_iterations`` = ntrial, ``tolx``, ``tolf``,
-``smoothing_type`` = smttype, ``end_derivative_order`` = iorder; ``passes`` (ad hoc
-passes), ``smoother``; distribution: ``alpha`` (smooth2D) and ``end0``, ``end1``,
-``centre``, ``centre_slope`` (smoothfoil). If the iteration does not converge the operator
-reports the residual history and cancels; nothing in the scene changes.
+The jobcard properties (Hvid 1993, Appendix / §3.4) come from
+:class:`.hvid_properties.HvidProperties`, shared with the import redo panel and the sidebar.
+A closed curve is smoothed with smoothing type 1 unless the caller sets the type. If the
+iteration does not converge the operator reports the residual history and what to change,
+and cancels; nothing in the scene changes.
+
+Reached from the curve context menus (object mode and edit mode, :data:`MENUS`), the
+sidebar's Curve Smoothing (Hvid) panel and *File > Import > Airfoil*'s Smooth option.
 """
 
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, FloatProperty, StringProperty
 
 from ..geometry.errors import BladesmithError, GeometryError
 from ..geometry.fairing import (
-    PolynomialDistribution,
-    SmoothingSettings,
     curvature_comb,
     curvature_plot,
     smooth2d,
@@ -36,6 +36,8 @@ from ..geometry.fairing import (
 )
 from ..geometry.fairing.curvature import span_samples
 from ..geometry.nurbs import BSplineCurve
+from ..geometry.fairing.hvid import is_closed
+from .hvid_properties import HvidProperties, draw_jobcard
 from .import_airfoil import stored_airfoil
 from .nurbs_objects import curve_to_object, object_to_geometry, remove_object, stored_geometry
 
@@ -170,45 +172,13 @@ def build_objects(source_obj, result, origin, axes, plot_height: float, comb_len
     return made
 
 
-class BLADESMITH_OT_smooth_curve(bpy.types.Operator):
+class BLADESMITH_OT_smooth_curve(HvidProperties, bpy.types.Operator):
     """Smooth the active curve by prescribing a smoothed curvature (Hvid 1993: smooth2D / smoothfoil)"""
 
     bl_idname = "bladesmith.smooth_curve"
     bl_label = "Smooth Curve (Hvid)"
     bl_options = {"REGISTER", "UNDO"}
 
-    kind: EnumProperty(
-        name="Kind",
-        items=[
-            ("AUTO", "Auto", "Airfoil for imported airfoils, curve otherwise"),
-            ("CURVE", "Curve (smooth2D)", "Any plane curve, curvature-weighted distribution"),
-            ("AIRFOIL", "Airfoil (smoothfoil)", "Airfoil outline TE-LE-TE: keeps LE curvature and chord"),
-        ],
-        default="AUTO",
-    )
-    output_points: IntProperty(name="np", description="Points of the final layout (jobcard np)", default=150, min=4)
-    smoothing_points: IntProperty(name="nsmooth", description="Points of the smoothing spline (jobcard nsmooth)", default=180, min=8)
-    max_iterations: IntProperty(name="ntrial", description="Maximum Newton/secant iterations (jobcard ntrial)", default=10, min=1)
-    tolx: FloatProperty(name="tolx", description="Tolerance on the sum of displacements", default=1e-10, min=0.0, precision=12)
-    tolf: FloatProperty(name="tolf", description="Tolerance on the sum of curvature residuals", default=1e-9, min=0.0, precision=12)
-    smoothing_type: EnumProperty(
-        name="Smoothing type",
-        items=[("1", "1: smooth all", "Smooth the curvature everywhere"), ("2", "2: keep maximum", "Keep the largest curvature (airfoil LE)")],
-        default="2",
-    )
-    smoother: EnumProperty(
-        name="Smoother",
-        items=[("ad_hoc", "Ad hoc (3-point)", "Passes of the 3-point mean"), ("least_squares", "Least squares", "Penalised least-squares spline")],
-        default="ad_hoc",
-    )
-    passes: IntProperty(name="Passes", description="Passes of the ad hoc smoother", default=4, min=0)
-    smoothing_weight: FloatProperty(name="LS weight", description="λ of the least-squares smoother (0: cross-validation)", default=10.0, min=0.0)
-    end_derivative_order: IntProperty(name="iorder", description="Order of the end-tangent finite differences", default=2, min=2, max=3)
-    alpha: FloatProperty(name="α", description="Damping of the curvature-weighted distribution (smooth2D)", default=3.0, min=0.0)
-    end0: FloatProperty(name="f'(0)", description="Airfoil distribution slope at the start", default=0.5, min=1e-6)
-    end1: FloatProperty(name="f'(1)", description="Airfoil distribution slope at the end", default=0.5, min=1e-6)
-    centre: FloatProperty(name="f(1/2)", description="Arc-length fraction of the middle point (the LE)", default=0.5, min=0.0, max=1.0, precision=4)
-    centre_slope: FloatProperty(name="f'(1/2)", description="Distribution slope at the LE", default=0.1, min=1e-6)
     make_plots: BoolProperty(name="Plots", description="Add curvature plots, comb and deviation", default=True)
     plot_height: FloatProperty(name="Plot height", description="Curvature plot height as a fraction of the curve's width", default=0.4, min=0.01)
     comb_length: FloatProperty(name="Comb length", description="Longest comb tooth as a fraction of the curve's width", default=0.15, min=0.0)
@@ -219,20 +189,6 @@ class BLADESMITH_OT_smooth_curve(bpy.types.Operator):
     def poll(cls, context):
         obj = context.active_object
         return obj is not None and obj.type == "CURVE"
-
-    def _settings(self) -> SmoothingSettings:
-        return SmoothingSettings(
-            smoothing_points=self.smoothing_points,
-            output_points=self.output_points,
-            max_iterations=self.max_iterations,
-            tolx=self.tolx,
-            tolf=self.tolf,
-            smoothing_type=int(self.smoothing_type),
-            smoother=self.smoother,
-            passes=self.passes,
-            end_derivative_order=self.end_derivative_order,
-            smoothing_weight=self.smoothing_weight,
-        )
 
     def execute(self, context):
         obj = context.active_object
@@ -265,26 +221,59 @@ class BLADESMITH_OT_smooth_curve(bpy.types.Operator):
         return {"FINISHED"}
 
     def _smooth(self, obj, progress):
-        settings = self._settings()
-        airfoil = stored_airfoil(obj)
-        kind = self.kind
-        if kind == "AUTO":
-            kind = "AIRFOIL" if airfoil is not None else "CURVE"
-        if kind == "AIRFOIL":
-            distribution = PolynomialDistribution(self.end0, self.end1, self.centre, self.centre_slope)
-            if airfoil is not None and stored_geometry(obj) is not None:
-                points, chord = airfoil
-                origin, axes = np.zeros(3), np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-                data = chord * points
-            else:
-                curve, origin, axes = read_planar_curve(obj)
-                data = curve.control_points if curve.degree == 1 else curve.evaluate(span_samples(curve, AIRFOIL_SAMPLES_PER_SPAN))
-            return smoothfoil(data, distribution, settings, progress), origin, axes
-        curve, origin, axes = read_planar_curve(obj)
-        # a cyclic Blender spline is a closed curve (smoothed periodically, no fixed seam);
-        # otherwise smooth2d detects coinciding ends itself
-        cyclic = bool(obj.data.splines) and bool(obj.data.splines[0].use_cyclic_u)
-        return smooth2d(curve, self.alpha, settings, progress, closed=True if cyclic else None), origin, axes
+        return smooth_object(obj, self, progress, type_given=self.properties.is_property_set("smoothing_type"))
+
+    def draw(self, context):
+        draw_jobcard(self.layout, self, self.kind)
+        col = self.layout.column(align=True)
+        col.prop(self, "make_plots")
+        if self.make_plots:
+            col.prop(self, "plot_height")
+            col.prop(self, "comb_length")
+            col.prop(self, "deviation_gain")
+        self.layout.prop(self, "filepath")
+
+
+def smooth_object(obj, props, progress=None, type_given: bool = True):
+    """(SmoothingResult, origin, axes) of Hvid smoothing ``obj`` with the jobcard ``props``
+    (:class:`HvidProperties`). AUTO: smoothfoil for imported airfoils, smooth2D otherwise.
+    A closed curve (cyclic spline, or ends that meet without a corner) is smoothed with
+    smoothing type 1 unless ``type_given``: type 2 keeps the largest curvature, which is an
+    airfoil's leading edge but on a closed outline just one of its noisy peaks."""
+    airfoil = stored_airfoil(obj)
+    kind = props.kind
+    if kind == "AUTO":
+        kind = "AIRFOIL" if airfoil is not None else "CURVE"
+    if kind == "AIRFOIL":
+        settings = props.smoothing_settings()
+        distribution = props.polynomial_distribution()
+        if airfoil is not None and stored_geometry(obj) is not None:
+            points, chord = airfoil
+            origin, axes = np.zeros(3), np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+            data = chord * points
+        else:
+            curve, origin, axes = read_planar_curve(obj)
+            data = curve.control_points if curve.degree == 1 else curve.evaluate(span_samples(curve, AIRFOIL_SAMPLES_PER_SPAN))
+        return smoothfoil(data, distribution, settings, progress), origin, axes
+    curve, origin, axes = read_planar_curve(obj)
+    # a cyclic Blender spline is a closed curve (smoothed periodically, no fixed seam);
+    # otherwise smooth2d detects coinciding ends itself
+    cyclic = bool(obj.data.splines) and bool(obj.data.splines[0].use_cyclic_u)
+    closed = True if cyclic else is_closed(curve)
+    settings = props.smoothing_settings(None if type_given or not closed else 1)
+    return smooth2d(curve, props.alpha, settings, progress, closed=closed), origin, axes
+
+
+def _menu_entry(self, context):
+    obj = context.active_object
+    if obj is not None and obj.type == "CURVE":
+        self.layout.separator()
+        self.layout.operator(BLADESMITH_OT_smooth_curve.bl_idname, icon="MOD_SMOOTH")
+
+
+#: Menus that show the smoother when the active object is a curve: the object context
+#: menu (right click in object mode), and edit mode's curve context menu and Curve menu.
+MENUS = ("VIEW3D_MT_object_context_menu", "VIEW3D_MT_edit_curve_context_menu", "VIEW3D_MT_edit_curve")
 
 
 _classes = (BLADESMITH_OT_smooth_curve,)
@@ -293,7 +282,11 @@ _register, _unregister = bpy.utils.register_classes_factory(_classes)
 
 def register():
     _register()
+    for name in MENUS:
+        getattr(bpy.types, name).append(_menu_entry)
 
 
 def unregister():
+    for name in reversed(MENUS):
+        getattr(bpy.types, name).remove(_menu_entry)
     _unregister()

@@ -296,6 +296,11 @@ def store_results(settings, molds: BladeMolds, seconds: float) -> None:
         smoothed = [st.airfoil.smoothing_deviation for st in defn.stations if st.airfoil.smoothing_deviation is not None]
         note = f"; airfoils smoothed (Hvid), worst deviation {max(smoothed):.2e} chord" if smoothed else ""
         aligned = "; aligned parameters (the chord-length ones missed)" if molds.aligned_parameters else ""
+        if settings.fairness_valid:  # both approaches are always built: the numbers in either mode
+            shown = "mold halves" if settings.mold_halves else "single surface"
+            note += (f"; fairness (Hosseini Eq. 6, shown: {shown}): MVS two-part {settings.mvs_two_part:.4g}, "
+                     f"single {settings.mvs_single:.4g}; strain energy two-part "
+                     f"{settings.strain_energy_two_part:.4g}, single {settings.strain_energy_single:.4g}")
         settings.status = (f"{molds.control_points} control points per half, worst section "
                            f"{settings.max_deviation:.2e} chord{note}{aligned}; {seconds * 1e3:.0f} ms")
         settings.status_is_error = False

@@ -12,9 +12,15 @@ Steps:
 5. ``blender_ext.py validate`` every zip and check it holds exactly its platform's wheels
    and nothing from the excluded folders.
 
-Blender bundles numpy but not scipy. Blender 4.2 LTS to 5.0 run Python 3.11 and bundle
-numpy 1.26.x; scipy 1.15.3 is built against numpy 2 headers, which keeps it importable with
-numpy >= 1.23.5, so the one pin covers every cp311 Blender. scipy needs nothing else.
+Blender bundles numpy but not scipy, and Blender installs from a zip only the wheels that
+match its own Python, so each zip carries one scipy wheel per Python ABI:
+
+- cp311 (Blender 4.2 LTS to 5.0, numpy 1.26.x): scipy 1.15.3, importable with
+  numpy >= 1.23.5, < 2.5;
+- cp313 (Blender 5.1 and 5.2 LTS, numpy >= 2.2 as the bpy 5.2 wheel requires): scipy 1.18.1,
+  importable with numpy >= 2.0, < 2.8.
+
+scipy needs nothing else.
 """
 from __future__ import annotations
 
@@ -32,9 +38,11 @@ MANIFEST = ROOT / "blender_manifest.toml"
 WHEEL_DIR = ROOT / "wheels"
 DIST_DIR = ROOT / "dist"
 
-SCIPY_VERSION = "1.15.3"
-PYTHON_VERSION = "3.11"
-ABI = "cp311"
+#: Python ABI -> (Python version for pip, scipy version), one wheel of each per platform.
+SCIPY: dict[str, tuple[str, str]] = {
+    "cp311": ("3.11", "1.15.3"),
+    "cp313": ("3.13", "1.18.1"),
+}
 
 #: Blender platform name -> pip ``--platform`` tags, most specific first. pip expands a
 #: macOS tag to every older macOS; manylinux tags are listed explicitly.
@@ -67,9 +75,10 @@ def run(args: list, **kwargs) -> subprocess.CompletedProcess:
     return subprocess.run([str(a) for a in args], check=True, **kwargs)
 
 
-def wheel_for(platform: str) -> pathlib.Path | None:
-    """The scipy wheel in ``wheels/`` whose platform tag belongs to ``platform``."""
-    for wheel in sorted(WHEEL_DIR.glob(f"scipy-{SCIPY_VERSION}-{ABI}-{ABI}-*.whl")):
+def wheel_for(platform: str, abi: str) -> pathlib.Path | None:
+    """The scipy wheel in ``wheels/`` for ``abi`` whose platform tag belongs to ``platform``."""
+    version = SCIPY[abi][1]
+    for wheel in sorted(WHEEL_DIR.glob(f"scipy-{version}-{abi}-{abi}-*.whl")):
         tag = wheel.name[: -len(".whl")].split("-", 4)[4]
         if any(_tag_matches(tag, wanted) for wanted in PLATFORMS[platform]):
             return wheel
@@ -89,25 +98,32 @@ def _tag_matches(tag: str, wanted: str) -> bool:
     return False
 
 
-def download_wheels() -> dict[str, pathlib.Path]:
+def _wanted(name: str) -> bool:
+    return any(name.startswith(f"scipy-{version}-{abi}-") for abi, (_, version) in SCIPY.items())
+
+
+def download_wheels() -> dict[str, list[pathlib.Path]]:
+    """platform -> its wheels, one per ABI of :data:`SCIPY`, downloaded when missing."""
     WHEEL_DIR.mkdir(exist_ok=True)
     for stale in WHEEL_DIR.glob("*.whl"):
-        if not stale.name.startswith(f"scipy-{SCIPY_VERSION}-{ABI}-"):
+        if not _wanted(stale.name):
             print(f"removing stale wheel {stale.name}")
             stale.unlink()
     wheels = {}
     for platform, tags in PLATFORMS.items():
-        wheel = wheel_for(platform)
-        if wheel is None:
-            platform_args = [arg for tag in tags for arg in ("--platform", tag)]
-            run([sys.executable, "-m", "pip", "download", "--quiet", "--disable-pip-version-check",
-                 f"scipy=={SCIPY_VERSION}", "--no-deps", "--only-binary=:all:",
-                 *platform_args, "--python-version", PYTHON_VERSION, "--implementation", "cp",
-                 "--abi", ABI, "--dest", WHEEL_DIR])
-            wheel = wheel_for(platform)
+        wheels[platform] = []
+        for abi, (python, version) in SCIPY.items():
+            wheel = wheel_for(platform, abi)
             if wheel is None:
-                raise SystemExit(f"build_extension: pip downloaded no scipy wheel for {platform}")
-        wheels[platform] = wheel
+                platform_args = [arg for tag in tags for arg in ("--platform", tag)]
+                run([sys.executable, "-m", "pip", "download", "--quiet", "--disable-pip-version-check",
+                     f"scipy=={version}", "--no-deps", "--only-binary=:all:",
+                     *platform_args, "--python-version", python, "--implementation", "cp",
+                     "--abi", abi, "--dest", WHEEL_DIR])
+                wheel = wheel_for(platform, abi)
+                if wheel is None:
+                    raise SystemExit(f"build_extension: pip downloaded no scipy {abi} wheel for {platform}")
+            wheels[platform].append(wheel)
     return wheels
 
 
@@ -117,7 +133,7 @@ def update_manifest(wheels: dict[str, pathlib.Path]) -> None:
     lines = [
         "platforms = [" + ", ".join(f'"{p}"' for p in PLATFORMS) + "]",
         "wheels = [",
-        *(f'  "./wheels/{wheels[p].name}",' for p in PLATFORMS),
+        *(f'  "./wheels/{wheel.name}",' for p in PLATFORMS for wheel in wheels[p]),
         "]",
     ]
     block = "# Written by scripts/build_extension.py (make extension).\n" + "\n".join(lines) + "\n"
@@ -136,11 +152,12 @@ def validate(cli: pathlib.Path, path: pathlib.Path) -> None:
     run([sys.executable, cli, "validate", path])
 
 
-def check_zip(path: pathlib.Path, platform: str, wheel: pathlib.Path) -> None:
+def check_zip(path: pathlib.Path, platform: str, wheels: list[pathlib.Path]) -> None:
     names = zipfile.ZipFile(path).namelist()
     bundled = sorted(n for n in names if n.endswith(".whl"))
-    if bundled != [f"wheels/{wheel.name}"]:
-        raise SystemExit(f"build_extension: {path.name} holds wheels {bundled}, expected only {wheel.name}")
+    expected = sorted(f"wheels/{w.name}" for w in wheels)
+    if bundled != expected:
+        raise SystemExit(f"build_extension: {path.name} holds wheels {bundled}, expected exactly {expected}")
     leaked = [n for n in names if n.startswith(EXCLUDED_TOP_LEVEL) or "__pycache__" in n]
     if leaked:
         raise SystemExit(f"build_extension: {path.name} holds excluded files, e.g. {leaked[:5]}")
@@ -162,11 +179,12 @@ def main(argv=None) -> int:
     for old in out.glob("bladesmith-*.zip"):
         old.unlink()
     run([sys.executable, cli, "build", "--source-dir", ROOT, "--output-dir", out, "--split-platforms"])
-    for platform, wheel in wheels.items():
+    for platform, platform_wheels in wheels.items():
         (zip_path,) = out.glob(f"bladesmith-*-{platform.replace('-', '_')}.zip")
         validate(cli, zip_path)
-        check_zip(zip_path, platform, wheel)
-        print(f"{zip_path.name}: {zip_path.stat().st_size / 1e6:.1f} MB, {platform}, {wheel.name}")
+        check_zip(zip_path, platform, platform_wheels)
+        print(f"{zip_path.name}: {zip_path.stat().st_size / 1e6:.1f} MB, {platform}, "
+              + ", ".join(w.name for w in platform_wheels))
     print(f"built {len(wheels)} zips in {time.perf_counter() - start:.1f} s")
     return 0
 

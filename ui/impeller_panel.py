@@ -21,10 +21,13 @@ turning Auto off starts from the current shape.
 """
 import bpy
 import numpy as np
-from bpy.props import BoolProperty, CollectionProperty, FloatProperty, FloatVectorProperty, PointerProperty, StringProperty
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty,
+                       PointerProperty, StringProperty)
 
 from ..operators.values import typed
 
+from ..geometry.compressor.blade import MAX_PATCHES, PATCH_SPACINGS
+from ..geometry.compressor.export import construction_summary
 from ..geometry.errors import BladesmithError
 
 #: Lists edited in the panel: (property name, TOML section, TOML key).
@@ -35,6 +38,11 @@ LISTS = (
     ("thickness_hub", "blade", "thickness_hub"), ("thickness_shroud", "blade", "thickness_shroud"),
 )
 SCALARS = ("leading_edge_hub", "leading_edge_shroud", "trailing_edge_hub", "trailing_edge_shroud")
+#: [blade] settings edited in the panel (issue 18): property name = [blade] key.
+BLADE_SETTINGS = ("count", "patches", "tolerance", "patch_spacing", "elements", "leading_edge_ratio",
+                  "trailing_edge_ratio")
+#: [splitter] settings: property "splitter_<key>" edits [splitter] <key>.
+SPLITTER_SETTINGS = ("leading_edge_hub", "leading_edge_shroud", "pitch_fraction", "patches", "leading_edge_ratio")
 #: Standardisation factors: property name = key of the [standardisation] table.
 FACTORS = ("shroud_factor", "hub_factor")
 #: Channel walls: the corner-angle and bend-fraction collections are ``{wall}_angle`` and
@@ -117,6 +125,24 @@ def standardisation_table(settings) -> dict:
     return {key: typed(getattr(settings, key)) for key in FACTORS if typed(getattr(settings, key)) != 1.0}
 
 
+def write_blade_settings(settings, data: dict) -> None:
+    """The panel's blade and splitter settings into the definition dictionary. Turning the
+    splitter on in a wheel that has none starts it halfway along the blade, half a pitch
+    off, with the blade's thickness."""
+    blade = data["blade"]
+    for key in BLADE_SETTINGS:
+        value = getattr(settings, key if key != "count" else "blade_count")
+        blade[key] = value if isinstance(value, (int, str)) else typed(value)
+    if not settings.splitter:
+        data.pop("splitter", None)
+        return
+    splitter = data.setdefault("splitter", {
+        "thickness_hub": list(blade["thickness_hub"]), "thickness_shroud": list(blade["thickness_shroud"])})
+    for key in SPLITTER_SETTINGS:
+        value = getattr(settings, f"splitter_{key}")
+        splitter[key] = value if isinstance(value, int) else typed(value)
+
+
 def on_edit(self, context):
     root = self.id_data  # the Object owning the group (items and the group alike)
     if root is None or not root.get("bladesmith_impeller_root"):
@@ -131,6 +157,7 @@ def on_edit(self, context):
         data[section][key] = [typed(item.value) for item in getattr(settings, name)]
     for key in SCALARS:
         data["blade"][key] = typed(getattr(settings, key))
+    write_blade_settings(settings, data)
     channel = data["channel"]
     for wall in WALLS:
         if len(getattr(settings, f"{wall}_angle")):  # empty in a root made before the walls were editable
@@ -146,6 +173,7 @@ def on_edit(self, context):
     try:
         model = regenerate(root, data, settings.full_wheel)
         settings.status = ""
+        settings.construction_report = construction_summary(model)[0]
         sync_auto_angles(settings, model.master_channel, data["channel"]["degrees"])
         settings.standardisation_report = "" if model.standardisation is None else model.standardisation.summary()
     except BladesmithError as exc:
@@ -206,11 +234,41 @@ class BladesmithImpellerSettings(bpy.types.PropertyGroup):
                     "of the width from the shroud (< 1 a hub cut; 1 = the master)",
         update=on_edit)
     standardisation_report: StringProperty(name="Standardisation", default="")
+    # blade settings (issue 18)
+    blade_count: IntProperty(name="Blades", default=15, min=1, max=200, update=on_edit,
+                             description="Number of blades Z")
+    patches: IntProperty(name="Patches", default=6, min=1, max=MAX_PATCHES, update=on_edit,
+                         description="Cubic-linear patches per blade surface; the least number when a tolerance is set")
+    tolerance: FloatProperty(name="Tolerance", default=1e-6, min=0.0, max=1e-2, precision=7, step=1e-5,
+                             update=on_edit,
+                             description="Camber and thickness tolerance as a fraction of the outer diameter; the "
+                                         "patch count is raised to meet it (edges on the walls to 1e-6 D at most); "
+                                         "0 keeps the patch count")
+    patch_spacing: EnumProperty(name="Spacing", items=[(k, k.capitalize(), f"Patch corners equidistant {t}")
+                                                       for k, t in zip(PATCH_SPACINGS, ("in meridional distance",
+                                                                                        "along the blade"))],
+                                update=on_edit)
+    elements: EnumProperty(name="Elements", items=[("arbitrary", "Arbitrary", "Straight line elements roughly normal "
+                                                    "to the walls"), ("axial", "Axial", "Axial straight line elements")],
+                           update=on_edit)
+    leading_edge_ratio: FloatProperty(name="LE rounding", default=3.0, min=0.0, max=20.0, update=on_edit,
+                                      description="Elliptic leading edge: semi-axes ratio; 0 = cut off")
+    trailing_edge_ratio: FloatProperty(name="TE rounding", default=0.0, min=0.0, max=20.0, update=on_edit,
+                                       description="Elliptic trailing edge: semi-axes ratio; 0 = cut off (closed by a "
+                                                   "flat face)")
+    splitter: BoolProperty(name="Splitter", default=False, update=on_edit)
+    splitter_leading_edge_hub: FloatProperty(name="Splitter LE hub U", default=1.5, update=on_edit)
+    splitter_leading_edge_shroud: FloatProperty(name="Splitter LE shroud U", default=1.5, update=on_edit)
+    splitter_pitch_fraction: FloatProperty(name="Pitch fraction", default=0.5, min=0.01, max=0.99, update=on_edit)
+    splitter_patches: IntProperty(name="Splitter patches", default=4, min=1, max=MAX_PATCHES, update=on_edit)
+    splitter_leading_edge_ratio: FloatProperty(name="Splitter LE rounding", default=3.0, min=0.0, max=20.0,
+                                               update=on_edit)
+    construction_report: StringProperty(name="Construction", default="")
     full_wheel: BoolProperty(name="Full Wheel", default=True)
     loading: BoolProperty(default=False)
     status: StringProperty(name="Status", default="")
 
-    def load(self, definition, full_wheel: bool, report: str = "") -> None:
+    def load(self, definition, full_wheel: bool, report: str = "", construction: str = "") -> None:
         """Fill the group from a definition without triggering regeneration."""
         self.loading = True
         try:
@@ -224,6 +282,16 @@ class BladesmithImpellerSettings(bpy.types.PropertyGroup):
                 setattr(self, key, float(d["blade"][key]))
             for key in FACTORS:
                 setattr(self, key, float(d.get("standardisation", {}).get(key, 1.0)))
+            for key in BLADE_SETTINGS:
+                setattr(self, key if key != "count" else "blade_count", d["blade"][key])
+            self.splitter = "splitter" in d
+            if self.splitter:
+                for key in SPLITTER_SETTINGS:
+                    setattr(self, f"splitter_{key}", d["splitter"][key])
+            else:
+                b = d["blade"]
+                self.splitter_leading_edge_hub = 0.5 * (b["leading_edge_hub"] + b["trailing_edge_hub"])
+                self.splitter_leading_edge_shroud = 0.5 * (b["leading_edge_shroud"] + b["trailing_edge_shroud"])
             degrees = d["channel"]["degrees"]
             for wall in WALLS:
                 corners = getattr(self, f"{wall}_angle")
@@ -245,6 +313,7 @@ class BladesmithImpellerSettings(bpy.types.PropertyGroup):
             self.full_wheel = full_wheel
             self.status = ""
             self.standardisation_report = report
+            self.construction_report = construction
         finally:
             self.loading = False
 
@@ -275,6 +344,26 @@ class BLADESMITH_PT_impeller(bpy.types.Panel):
         col = layout.column(align=True)
         for key in SCALARS:
             col.prop(settings, key)
+        box = layout.box()
+        box.label(text="Blade")
+        col = box.column(align=True)
+        for key in ("blade_count", "patches", "tolerance", "patch_spacing", "elements", "leading_edge_ratio",
+                    "trailing_edge_ratio"):
+            col.prop(settings, key)
+        if settings.construction_report:
+            box.label(text=settings.construction_report, icon="INFO")
+        box = layout.box()
+        box.prop(settings, "splitter")
+        col = box.column(align=True)
+        col.enabled = settings.splitter
+        for key in SPLITTER_SETTINGS:
+            col.prop(settings, f"splitter_{key}")
+        row = layout.row(align=True)
+        row.operator("bladesmith.save_impeller_definition", icon="FILE_TICK")
+        row.operator("bladesmith.export_impeller_cfd", icon="EXPORT")
+        row = layout.row(align=True)
+        row.operator("bladesmith.impeller_net", icon="MESH_GRID")
+        row.operator("bladesmith.impeller_sections", icon="MOD_SLICE")
         box = layout.box()
         box.label(text="Standardisation")
         col = box.column(align=True)

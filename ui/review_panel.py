@@ -30,7 +30,11 @@ class BLADESMITH_PT_curvature_review(bpy.types.Panel):
         settings = json.loads(coll.get(SETTINGS_KEY, "{}"))
         if settings:
             lo, hi = settings["limits"]
-            layout.label(text=f"{settings['quantity']}: limits ±{hi:.3g}, {100 * settings.get('clipped', 0):.1f}% clipped")
+            layout.label(text=f"{settings['quantity']}: limits [{lo:.3g}, {hi:.3g}], {100 * settings.get('clipped', 0):.1f}% clipped")
+            if settings.get("sign_convention"):
+                layout.label(text=settings["sign_convention"])
+            if settings.get("excluded_from_limits"):
+                layout.label(text="not in the limits: " + ", ".join(settings["excluded_from_limits"]))
         for obj in sorted(coll.objects, key=lambda o: o.name):
             text = obj.get(NUMBERS_KEY)
             if not text:

@@ -16,6 +16,7 @@ NURBS Book 2e §5.4), so the Blender display and IGES take them unchanged.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from math import comb
 
 import numpy as np
@@ -34,9 +35,14 @@ def bernstein(degree: int, u) -> np.ndarray:
     if n < 0:
         raise GeometryError(f"degree must be >= 0, got {degree}")
     u = np.asarray(u, dtype=float)[..., None]
-    k = np.arange(n + 1)
-    binom = np.array([comb(n, i) for i in range(n + 1)], dtype=float)
+    k, binom = _binomials(n)
     return binom * u**k * (1.0 - u) ** (n - k)
+
+
+@lru_cache(maxsize=64)
+def _binomials(n: int) -> tuple[np.ndarray, np.ndarray]:
+    k = np.arange(n + 1)
+    return k, np.array([comb(n, i) for i in range(n + 1)], dtype=float)
 
 
 def _as_polygon(points, what: str) -> np.ndarray:
@@ -234,16 +240,16 @@ class BezierString:
             if gap > JOIN_TOLERANCE * scale:
                 raise GeometryError(f"segments {j} and {j + 1} do not meet: gap {gap:.3g}")
         object.__setattr__(self, "segments", segs)
-        # polygons of the successive hodographs (Eq. 9) of each segment, for evaluation
-        tables = []
-        for seg in segs:
-            P = np.array(seg.control_points)
-            polys = [P]
-            while P.shape[0] > 1:
-                P = (P.shape[0] - 1) * np.diff(P, axis=0)
-                polys.append(P)
-            tables.append(polys)
-        object.__setattr__(self, "_hodographs", tables)
+        # for vectorised evaluation: the polygons of the successive hodographs (Eq. 9) of all
+        # segments at the highest degree (elevation is exact), stacked per order
+        p = max(sg.degree for sg in segs)
+        P = np.stack([np.asarray(sg.elevate(p - sg.degree).control_points if sg.degree < p else sg.control_points)
+                      for sg in segs])
+        stacked = [P]
+        while P.shape[1] > 1:
+            P = (P.shape[1] - 1) * np.diff(P, axis=1)
+            stacked.append(P)
+        object.__setattr__(self, "_stacked", stacked)
 
     @property
     def count(self) -> int:
@@ -259,16 +265,12 @@ class BezierString:
         U = np.asarray(U, dtype=float)
         j, u = _split_parameter(U.ravel(), self.count)
         out = np.empty((order + 1, u.size, self.dim))
-        for k, polys in enumerate(self._hodographs):
-            mask = j == k
-            if not np.any(mask):
-                continue
-            uk = u[mask]
-            for d in range(order + 1):
-                if d < len(polys):
-                    out[d, mask] = bernstein(polys[d].shape[0] - 1, uk) @ polys[d]
-                else:
-                    out[d, mask] = 0.0
+        stacked = self._stacked
+        for d in range(order + 1):
+            if d < len(stacked):
+                out[d] = np.einsum("ki,kid->kd", bernstein(stacked[d].shape[1] - 1, u), stacked[d][j])
+            else:
+                out[d] = 0.0
         return out.reshape((order + 1,) + U.shape + (self.dim,))
 
     def evaluate(self, U) -> np.ndarray:

@@ -42,7 +42,7 @@ from scipy.linalg import solve_banded
 from scipy.optimize import brentq
 
 from ..errors import DefinitionError, GeometryError
-from .bezier import BezierCurve, BezierString, PatchString, RuledPatch, bernstein_function, bernstein_function_derivative
+from .bezier import BezierCurve, BezierString, PatchString, bernstein_function, bernstein_function_derivative
 from .channel import MeridionalChannel
 
 #: Gauss–Legendre points per quadrature interval and intervals per wall for m(U), φ(U).
@@ -126,7 +126,10 @@ class WallCamber:
         self.U0, self.U1 = float(U0), float(U1)
         self.beta_coefficients = np.radians(np.asarray(beta_deg, dtype=float))
         self.phi0 = float(phi0)
-        edges = np.linspace(self.U0, self.U1, QUADRATURE_INTERVALS + 1)
+        # the channel patches are G2 but each spans one unit of U, so |M'(U)| jumps at
+        # their junctions: those must be interval edges, never inside a Gauss interval
+        junctions = np.arange(np.floor(self.U0) + 1.0, np.ceil(self.U1))
+        edges = np.union1d(np.linspace(self.U0, self.U1, QUADRATURE_INTERVALS + 1), junctions)
         self._edges = edges
         h = np.diff(edges)
         nodes = edges[:-1, None] + 0.5 * h[:, None] * (_GL_X[None, :] + 1.0)
@@ -137,6 +140,8 @@ class WallCamber:
             raise GeometryError("the blade has zero meridional length")
         rate = self._phi_rate(nodes.ravel()).reshape(nodes.shape)
         self._phi_table = self.phi0 + np.r_[0.0, np.cumsum(0.5 * h * (rate @ _GL_W))]
+        rate = self._length_rate(nodes.ravel()).reshape(nodes.shape)
+        self._s_table = np.r_[0.0, np.cumsum(0.5 * h * (rate @ _GL_W))]
 
     def _speed(self, U) -> np.ndarray:
         d = self.wall.derivatives(U, 1)[1]
@@ -145,7 +150,7 @@ class WallCamber:
     def _partial(self, U, integrand) -> tuple[np.ndarray, np.ndarray]:
         """(k, ∫_{edge_k}^{U} integrand dU) for the table interval k holding U."""
         U = np.asarray(U, dtype=float)
-        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, QUADRATURE_INTERVALS - 1)
+        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 2)
         a = self._edges[k]
         half = 0.5 * (U - a)
         nodes = a[..., None] + half[..., None] * (_GL_X + 1.0)
@@ -177,16 +182,39 @@ class WallCamber:
         k, part = self._partial(U, self._phi_rate)
         return self._phi_table[k] + part
 
-    def U_of_m(self, m) -> np.ndarray:
-        """Inverse of m(U) by table interpolation and Newton steps on dm/dU = |M'(U)|."""
-        m = np.asarray(m, dtype=float)
-        U = np.interp(m, self._m_table, self._edges)
+    def _length_rate(self, U) -> np.ndarray:
+        return self._speed(U) / np.cos(self.beta(U))
+
+    def s(self, U) -> np.ndarray:
+        """Length along the camber line on this wall from the LE, ds = dm / cos β (the
+        blade-surface measure of Casey 1983 step e)."""
+        k, part = self._partial(U, self._length_rate)
+        return self._s_table[k] + part
+
+    def _invert(self, values, measure, rate, table, clip: bool = True) -> np.ndarray:
+        values = np.asarray(values, dtype=float)
+        U = np.interp(values, table, self._edges)
+        if not clip:
+            # beyond the blade (rounded end caps): start from the end slope
+            U = np.where(values < table[0], self.U0 + (values - table[0]) / rate(self.U0), U)
+            U = np.where(values > table[-1], self.U1 + (values - table[-1]) / rate(self.U1), U)
         for _ in range(20):
-            step = (self.m(U) - m) / self._speed(U)
-            U = np.clip(U - step, self.U0, self.U1)
+            step = (measure(U) - values) / rate(U)
+            U = U - step
+            if clip:
+                U = np.clip(U, self.U0, self.U1)
             if np.all(np.abs(step) < INVERSE_TOLERANCE):
                 break
         return U
+
+    def U_of_m(self, m, clip: bool = True) -> np.ndarray:
+        """Inverse of m(U) by table interpolation and Newton steps on dm/dU = |M'(U)|;
+        ``clip=False`` follows the wall beyond the blade's LE and TE."""
+        return self._invert(m, self.m, self._speed, self._m_table, clip)
+
+    def U_of_s(self, s) -> np.ndarray:
+        """Inverse of :meth:`s`."""
+        return self._invert(s, self.s, self._length_rate, self._s_table)
 
 
 # -- corner points and end slopes ---------------------------------------------------------------
@@ -205,9 +233,9 @@ class WallBlade:
         return float(self.camber.m(self.U0)), float(self.camber.m(self.U1))
 
 
-def _surface_state(wb: WallBlade, U, side: float):
-    """Points X (k, 3) and dX/dm (k, 3) of surface ``side`` (0 B, +1 P, -1 S) at U, and
-    the angle of dX/dm from the meridional direction (rad)."""
+def _surface_phi(wb: WallBlade, U, side: float):
+    """Target of surface ``side`` (0 B, +1 P, -1 S) on its wall at channel parameter U
+    (Casey 1983 steps c and d): z, r, φ, dφ/dm and the wall direction (sin ε, cos ε)."""
     c = wb.camber
     U = np.asarray(U, dtype=float)
     zr, dzr = c.wall.derivatives(U, 1)
@@ -226,6 +254,13 @@ def _surface_state(wb: WallBlade, U, side: float):
     phi = c.phi(U) + wb.phi_offset + side * half
     dhalf = ddelta / (2.0 * r * cb) - delta * sin_e / (2.0 * r * r * cb) + half * np.tan(beta) * dbeta
     dphi = np.tan(beta) / r + side * dhalf
+    return z, r, phi, dphi, sin_e, cos_e
+
+
+def _surface_state(wb: WallBlade, U, side: float):
+    """Points X (k, 3) and dX/dm (k, 3) of surface ``side`` (0 B, +1 P, -1 S) at U, and
+    the angle of dX/dm from the meridional direction (rad)."""
+    z, r, phi, dphi, sin_e, cos_e = _surface_phi(wb, U, side)
     X = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
     dX = np.stack(
         [sin_e * np.cos(phi) - r * np.sin(phi) * dphi, sin_e * np.sin(phi) + r * np.cos(phi) * dphi, cos_e], axis=-1
@@ -233,31 +268,61 @@ def _surface_state(wb: WallBlade, U, side: float):
     return X, dX, np.arctan(r * dphi)
 
 
-def corner_parameters(wb: WallBlade, n_patches: int) -> np.ndarray:
-    """Channel U of the n+1 patch corners, equidistant in m between the blade's LE and TE
-    (Casey 1983 step e)."""
-    m0, m1 = wb.m_range()
-    U = wb.camber.U_of_m(np.linspace(m0, m1, n_patches + 1))
+#: Casey's (1983, step e) two patch spacings: equidistant along the projection of the
+#: blade onto the meridional channel (in m), or along the blade surface (camber-line
+#: length s on each wall, ds = dm / cos β).
+PATCH_SPACINGS = ("meridional", "blade")
+
+
+def corner_parameters(wb: WallBlade, n_patches: int, spacing: str = "meridional") -> np.ndarray:
+    """Channel U of the n+1 patch corners, equidistant between the blade's LE and TE in
+    the measure ``spacing`` (:data:`PATCH_SPACINGS`, Casey 1983 step e)."""
+    c = wb.camber
+    if spacing == "meridional":
+        m0, m1 = wb.m_range()
+        U = c.U_of_m(np.linspace(m0, m1, n_patches + 1))
+    elif spacing == "blade":
+        s0, s1 = float(c.s(wb.U0)), float(c.s(wb.U1))
+        U = c.U_of_s(np.linspace(s0, s1, n_patches + 1))
+    else:
+        raise GeometryError(f"patch spacing must be one of {PATCH_SPACINGS}, got {spacing!r}")
     U[0], U[-1] = wb.U0, wb.U1
     return U
+
+
+def _end_speed(wb: WallBlade, U_corners: np.ndarray, spacing: str) -> tuple[float, float]:
+    """dm/dt at the LE and TE of a string whose corners are one unit of t apart and
+    equidistant in the ``spacing`` measure: Δm for meridional spacing, Δs · cos β for
+    blade spacing (so the imposed end derivative matches the parameter speed)."""
+    c = wb.camber
+    if spacing == "meridional":
+        m = c.m(U_corners[[0, 1]])
+        return float(m[1] - m[0]), float(m[1] - m[0])
+    s = c.s(U_corners[[0, -1]])
+    ds = (float(s[1]) - float(s[0])) / (len(U_corners) - 1)
+    cb = np.cos(c.beta(U_corners[[0, -1]]))
+    return ds * float(cb[0]), ds * float(cb[1])
 
 
 @dataclass(frozen=True, eq=False)
 class BladeSurfaces:
     """One blade: camber surface B, suction S and pressure P as strings of cubic-linear
     patches (lower curve on the hub, v = 0; upper on the shroud, v = 1; U in [0, n]),
-    optional rounded LE/TE end patches joining P to S, the channel U of the corners on
-    hub and shroud (2, n+1), and the imposed end angles (rad) per surface as
-    {"B"|"S"|"P": (2 walls, 2 ends)}."""
+    the LE and TE end caps joining P to S (rounded, or the flat face closing a cut-off
+    edge; strings of cubic-linear patches too, or None when the edge has no thickness),
+    the channel U of the corners on hub and shroud (2, n+1), the imposed end angles (rad)
+    per surface as {"B"|"S"|"P": (2 walls, 2 ends)} and the construction ``report``
+    (:func:`build_blade`)."""
 
     camber: PatchString
     suction: PatchString
     pressure: PatchString
-    leading_edge: RuledPatch | None
-    trailing_edge: RuledPatch | None
+    leading_edge: PatchString | None
+    trailing_edge: PatchString | None
     corner_U: np.ndarray
     imposed_angles: dict = field(default_factory=dict)
     axial_elements: bool = False
+    report: dict = field(default_factory=dict)
 
     @property
     def count(self) -> int:
@@ -273,17 +338,12 @@ class BladeSurfaces:
         def turn_string(s: BezierString) -> BezierString:
             return BezierString(tuple(BezierCurve(seg.control_points @ R.T) for seg in s.segments))
 
-        def turn(p: PatchString) -> PatchString:
-            return PatchString(turn_string(p.lower), turn_string(p.upper))
-
-        def turn_patch(p):
-            if p is None:
-                return None
-            return RuledPatch(BezierCurve(p.lower.control_points @ R.T), BezierCurve(p.upper.control_points @ R.T))
+        def turn(p: PatchString | None) -> PatchString | None:
+            return None if p is None else PatchString(turn_string(p.lower), turn_string(p.upper))
 
         return BladeSurfaces(
-            turn(self.camber), turn(self.suction), turn(self.pressure), turn_patch(self.leading_edge),
-            turn_patch(self.trailing_edge), self.corner_U, self.imposed_angles, self.axial_elements,
+            turn(self.camber), turn(self.suction), turn(self.pressure), turn(self.leading_edge),
+            turn(self.trailing_edge), self.corner_U, self.imposed_angles, self.axial_elements, self.report,
         )
 
 
@@ -292,37 +352,276 @@ def _rotation(angle: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def rounded_end_patch(first: PatchString, second: PatchString, end: int, ratio_hub: float, ratio_shroud: float,
-                      thickness_hub: float, thickness_shroud: float) -> RuledPatch | None:
-    """A cubic-linear end patch closing the blade at the LE (end 0) or TE (end 1): on each
-    wall the cubic from the ``first`` surface's end point to the ``second``'s, with
-    polygon P_0, P_0 ∓ k t_1, Q_0 ∓ k t_2, Q_0 (t the unit end tangents along the blade),
-    k = 4/3 · ratio · δ/2. This is tangent to both surfaces (G1) and is the cubic
-    Bézier form of a half ellipse of semi-axes (ratio · δ/2, δ/2) (Casey 1983 step g,
-    after Smith & Merryweather). Returns None when ``ratio`` is 0 on both walls."""
-    if ratio_hub <= 0.0 and ratio_shroud <= 0.0:
-        return None
-    curves = []
-    for which, ratio, delta in (("lower", ratio_hub, thickness_hub), ("upper", ratio_shroud, thickness_shroud)):
-        a_string = getattr(first, which)
-        b_string = getattr(second, which)
-        if end == 0:
-            A = a_string.segments[0].control_points
-            B = b_string.segments[0].control_points
-            pa, ta = A[0], A[1] - A[0]
-            pb, tb = B[0], B[1] - B[0]
-            sign = -1.0
+# -- edges on the walls, deviations from the prescription ------------------------------------
+#: Default largest distance of a blade edge from its channel wall, as a fraction of the
+#: outer diameter (:func:`outer_diameter`). Casey's ruled surfaces are bounded by curves on
+#: the walls; a cubic cannot follow a curve on a surface of revolution exactly, so the patch
+#: count is raised until the edges lie on the walls to this.
+WALL_TOLERANCE = 1e-6
+#: Default tolerance on the camber line (rθ against φ(m) of step c) and on S and P against
+#: ±δ/2 (step d), as a fraction of the outer diameter.
+DEFAULT_TOLERANCE = 1e-6
+#: Most patches the adaptive construction uses per surface, and per end cap.
+MAX_PATCHES = 256
+MAX_CAP_PATCHES = 64
+#: Samples per patch when measuring the deviations.
+CHECK_SAMPLES = 4
+#: A C2 cubic interpolant's error falls as h^4: the next count is n (e/tol)^(1/4) times this.
+PATCH_MARGIN = 1.15
+#: Foot points on a wall: Newton iterations and step tolerance (wall parameter).
+FOOT_ITERATIONS = 30
+FOOT_TOLERANCE = 1e-14
+#: Wall samples per patch for the starting guesses of foot points far from any corner.
+GUESS_SAMPLES = 64
+
+
+def outer_diameter(hub: WallBlade, shroud: WallBlade) -> float:
+    """2 × the largest radius of the blade's four corners: the length scale of the
+    tolerances (the wheel's outer diameter for an impeller)."""
+    r = [float(wb.camber.wall.evaluate(U)[1]) for wb in (hub, shroud) for U in (wb.U0, wb.U1)]
+    return 2.0 * max(r)
+
+
+def wall_foot(wall: BezierString, zr, U_guess) -> tuple[np.ndarray, np.ndarray]:
+    """Foot points (U) and distances of meridional points ``zr`` (k, 2) on the wall contour,
+    by Newton on C'(U)·(C(U) - X) = 0 from ``U_guess`` (The NURBS Book 2e Eqs. 6.3–6.4)."""
+    X = np.asarray(zr, dtype=float)
+    U = np.array(U_guess, dtype=float)
+    for _ in range(FOOT_ITERATIONS):
+        C = wall.derivatives(U, 2)
+        d = C[0] - X
+        f = np.sum(C[1] * d, axis=-1)
+        fp = np.sum(C[2] * d, axis=-1) + np.sum(C[1] * C[1], axis=-1)
+        step = f / fp
+        U = np.clip(U - step, 0.0, wall.count)
+        if np.max(np.abs(step), initial=0.0) < FOOT_TOLERANCE:
+            break
+    return U, np.linalg.norm(wall.evaluate(U) - X, axis=-1)
+
+
+def _guess(wall: BezierString, zr) -> np.ndarray:
+    Us = np.linspace(0.0, wall.count, wall.count * GUESS_SAMPLES + 1)
+    W = wall.evaluate(Us)
+    return Us[np.argmin(np.linalg.norm(W[None, :, :] - np.asarray(zr)[:, None, :], axis=-1), axis=1)]
+
+
+def _meridional(X) -> np.ndarray:
+    return np.stack([X[..., 2], np.hypot(X[..., 0], X[..., 1])], axis=-1)
+
+
+def _samples(count: int) -> np.ndarray:
+    return (np.arange(count)[:, None] + (np.arange(CHECK_SAMPLES + 1) / CHECK_SAMPLES)[None, :]).ravel()
+
+
+def edge_deviation(wb: WallBlade, string: BezierString, U_corners, side: float | None) -> tuple[float, float]:
+    """(largest distance of ``string`` from its wall, largest circumferential error rθ
+    against the target of surface ``side`` of steps c–d at the same wall point); side
+    None: the wall distance only. Measured at CHECK_SAMPLES per patch."""
+    t = _samples(string.count)
+    X = string.evaluate(t)
+    zr = _meridional(X)
+    wall = wb.camber.wall
+    guess = np.interp(t, np.arange(len(U_corners)), U_corners) if U_corners is not None and np.all(
+        np.isfinite(U_corners)) else _guess(wall, zr)
+    U, gap = wall_foot(wall, zr, guess)
+    if side is None:
+        return float(gap.max()), 0.0
+    U = np.clip(U, wb.U0, wb.U1)
+    _, r, phi, *_ = _surface_phi(wb, U, side)
+    dphi = np.angle(np.exp(1j * (np.arctan2(X[:, 1], X[:, 0]) - phi)))
+    return float(gap.max()), float(np.max(r * np.abs(dphi)))
+
+
+def _wall_strings(channel, hub: WallBlade, shroud: WallBlade, n: int, axial: bool, spacing: str):
+    """Steps e–f for ``n`` patches: the hub and shroud strings of B, S and P, the imposed
+    end angles and the corner parameters."""
+    U_hub = corner_parameters(hub, n, spacing)
+    walls = [(hub, U_hub, "lower")]
+    U_shroud = np.full_like(U_hub, np.nan)
+    if not axial:
+        U_shroud = corner_parameters(shroud, n, spacing)
+        walls.append((shroud, U_shroud, "upper"))
+    strings, imposed = {}, {}
+    for name, side in (("B", 0.0), ("S", -1.0), ("P", 1.0)):
+        angles = np.zeros((2, 2))
+        for w, (wb, U, which) in enumerate(walls):
+            X, dX, ang = _surface_state(wb, U, side)
+            angles[w] = ang[[0, -1]]
+            v0, v1 = _end_speed(wb, U, spacing)
+            strings[(name, which)] = cubic_string_through(X, dX[0] * v0, dX[-1] * v1)
+        imposed[name] = angles
+    if axial:
+        for name in ("B", "S", "P"):
+            strings[(name, "upper")] = _axial_shroud(channel, strings[(name, "lower")], shroud, U_hub)
+            imposed[name][1] = np.nan  # the shroud angles follow from the hub
+    surfaces = {name: PatchString(strings[(name, "lower")], strings[(name, "upper")]) for name in ("B", "S", "P")}
+    return surfaces, imposed, U_hub, U_shroud
+
+
+def _deviations(hub: WallBlade, shroud: WallBlade, surfaces: dict, U_hub, U_shroud, axial: bool) -> dict:
+    """Largest wall distance of the hub and shroud edges of B, S and P, camber error (B)
+    and offset error of S and P (steps c and d), in metres."""
+    gap = camber = offset = 0.0
+    for name, side in (("B", 0.0), ("S", -1.0), ("P", 1.0)):
+        for wb, string, U, s in ((hub, surfaces[name].lower, U_hub, side),
+                                 (shroud, surfaces[name].upper, U_shroud, None if axial else side)):
+            g, e = edge_deviation(wb, string, U, s)
+            gap = max(gap, g)
+            if name == "B":
+                camber = max(camber, e)
+            else:
+                offset = max(offset, e)
+    return {"wall_gap": gap, "camber": camber, "thickness": offset}
+
+
+# -- LE/TE end caps on the walls ------------------------------------------------------------
+def _hermite(t, rho0: float, rho1: float) -> np.ndarray:
+    """σ(t) on [0, 1] with σ(0) = 0, σ(1) = 1, σ'(0) = ρ0, σ'(1) = ρ1 (cubic Hermite)."""
+    t2, t3 = t * t, t * t * t
+    return (3.0 * t2 - 2.0 * t3) + rho0 * (t3 - 2.0 * t2 + t) + rho1 * (t3 - t2)
+
+
+class _CapWall:
+    """One wall's edge of an end cap, exactly on the wall: a cubic Bézier c(σ) in the
+    developed (m, φ) coordinates of the wall (the half ellipse of semi-axes ratio · δ/2 and
+    δ/2 in the metric (dm, r dφ) of Casey 1983 step g, or the straight line of a cut-off
+    edge) mapped onto the wall surface of revolution, X = (r(m) cos φ, r(m) sin φ, z(m))."""
+
+    def __init__(self, wb: WallBlade, end: int, ratio: float, speed: float):
+        c = wb.camber
+        self.wb = wb
+        U_end = wb.U0 if end == 0 else wb.U1
+        out = -1.0 if end == 0 else 1.0
+        m_end = float(c.m(U_end))
+        first, second = (1.0, -1.0) if end == 0 else (-1.0, 1.0)  # LE: P to S; TE: S to P
+        delta = float(bernstein_function(wb.thickness, np.array([float(end)]))[0])
+        state = {}
+        for side in (first, second):
+            _, r, phi, dphi, _, _ = _surface_phi(wb, np.array([U_end]), side)
+            state[side] = (float(r[0]), float(phi[0]), float(dphi[0]))
+        r0, phi0, d0 = state[first]
+        r3, phi3, d3 = state[second]
+        c0, c3 = np.array([m_end, phi0]), np.array([m_end, phi3])
+        self.rounded = ratio > 0.0
+        if self.rounded:
+            k = 4.0 / 3.0 * ratio * 0.5 * delta
+            n0, n3 = np.hypot(1.0, r0 * d0), np.hypot(1.0, r3 * d3)
+            c1 = c0 + out * k / n0 * np.array([1.0, d0])
+            c2 = c3 + out * k / n3 * np.array([1.0, d3])
+            # c'(0) = 3 out k / n0 · d(m, φ)/dm of the first surface, whose string has
+            # dX/dt = dX/dm · speed there: the cap's end derivative is lam0 times it
+            self.lam = (3.0 * k / (n0 * speed), 3.0 * k / (n3 * speed))
         else:
-            A = a_string.segments[-1].control_points
-            B = b_string.segments[-1].control_points
-            pa, ta = A[-1], A[-1] - A[-2]
-            pb, tb = B[-1], B[-1] - B[-2]
-            sign = 1.0
-        k = 4.0 / 3.0 * ratio * 0.5 * delta
-        ta = ta / np.linalg.norm(ta)
-        tb = tb / np.linalg.norm(tb)
-        curves.append(BezierCurve(np.array([pa, pa + sign * k * ta, pb + sign * k * tb, pb])))
-    return RuledPatch(curves[0], curves[1])
+            c1, c2 = c0 + (c3 - c0) / 3.0, c0 + 2.0 * (c3 - c0) / 3.0
+            self.lam = (1.0, 1.0)
+        self.polygon = np.array([c0, c1, c2, c3])
+        self.rho = (1.0, 1.0)
+
+    def developed(self, t, order: int = 0) -> np.ndarray:
+        s = _hermite(t, *self.rho)
+        return BezierCurve(self.polygon).derivatives(s, order)
+
+    def evaluate(self, t) -> np.ndarray:
+        mp = self.developed(np.asarray(t, float))[0]
+        c = self.wb.camber
+        U = c.U_of_m(mp[..., 0], clip=False)
+        zr = c.wall.evaluate(U)
+        phi = mp[..., 1]
+        return np.stack([zr[..., 1] * np.cos(phi), zr[..., 1] * np.sin(phi), zr[..., 0]], axis=-1)
+
+    def flat_derivatives(self) -> tuple[np.ndarray, np.ndarray]:
+        """dX/dt at both ends of a cut-off cap: Δφ ∂X/∂φ (a circular arc on the wall)."""
+        out = []
+        for t in (0.0, 1.0):
+            X = self.evaluate(np.array([t]))[0]
+            dphi = self.polygon[3, 1] - self.polygon[0, 1]
+            out.append(dphi * np.array([-X[1], X[0], 0.0]))
+        return out[0], out[1]
+
+
+def _end_derivative(string: BezierString, end: int) -> np.ndarray:
+    P = string.segments[0 if end == 0 else -1].control_points
+    return 3.0 * (P[1] - P[0]) if end == 0 else 3.0 * (P[-1] - P[-2])
+
+
+def end_cap(channel: MeridionalChannel, hub: WallBlade, shroud: WallBlade, surfaces: dict, end: int, ratio: float,
+            axial: bool, speeds: dict, tolerance: float) -> tuple[PatchString, float]:
+    """The LE (end 0: P to S) or TE (end 1: S to P) cap and its largest deviation from
+    its exact on-wall edges (:class:`_CapWall`), Casey 1983 step g.
+
+    Rounded (ratio > 0): G1 with S and P along the whole junction ruling. Two ruled surfaces
+    sharing a ruling are tangent along all of it when the u-derivatives of the cap's two
+    edges are the SAME multiple λ of the adjoining surface's edge derivatives (the normals
+    are then (1-v)(λA') + v(λB') × (B - A) = λ N). Each wall's half ellipse asks for its
+    own λ_w; the common λ is their mean, and each wall's edge is reparameterised by a cubic
+    σ(t) with σ'(0) = λ / λ_w so that its exact shape is kept. Cut-off (ratio 0): the flat
+    face closing the edge, its wall edges circular arcs at the edge's m.
+
+    Each edge is the C2 cubic string (Eqs. A1–A4) through the exact on-wall points at
+    n_c + 1 uniform t, with the end derivatives imposed, n_c doubled until the string lies
+    within ``tolerance`` of the exact edge; the end points are the S and P corners
+    themselves (copied arrays, so the shared rulings are equal)."""
+    first, second = ("P", "S") if end == 0 else ("S", "P")
+    out = -1.0 if end == 0 else 1.0
+    walls = [("lower", hub)] if axial else [("lower", hub), ("upper", shroud)]
+    caps = {which: _CapWall(wb, end, ratio, speeds[which]) for which, wb in walls}
+    lam0 = float(np.mean([c.lam[0] for c in caps.values()]))
+    lam1 = float(np.mean([c.lam[1] for c in caps.values()]))
+    for cap in caps.values():
+        cap.rho = (lam0 / cap.lam[0], lam1 / cap.lam[1]) if cap.rounded else (1.0, 1.0)
+        if not all(0.0 < r < 3.0 for r in cap.rho):
+            raise GeometryError(f"the {'leading' if end == 0 else 'trailing'} edge rounding differs too much between "
+                                f"hub and shroud for one tangent-continuous cap (λ ratios {cap.rho})")
+    n_c = 1 if ratio <= 0.0 else 2
+    while True:
+        strings, dev = {}, 0.0
+        t = np.linspace(0.0, 1.0, n_c + 1)
+        for which, wb in walls:
+            cap = caps[which]
+            A = getattr(surfaces[first], which)
+            B = getattr(surfaces[second], which)
+            pts = cap.evaluate(t)
+            pts[0] = A.segments[0 if end == 0 else -1].control_points[0 if end == 0 else -1]
+            pts[-1] = B.segments[0 if end == 0 else -1].control_points[0 if end == 0 else -1]
+            if cap.rounded:
+                D0 = out * lam0 * _end_derivative(A, end)
+                D1 = -out * lam1 * _end_derivative(B, end)
+            else:
+                D0, D1 = cap.flat_derivatives()
+            strings[which] = cubic_string_through(pts, D0 / n_c, D1 / n_c)
+            T = _samples(n_c)
+            dev = max(dev, float(np.max(np.linalg.norm(strings[which].evaluate(T) - cap.evaluate(T / n_c), axis=-1))))
+        if axial:
+            strings["upper"] = _axial_shroud(channel, strings["lower"], shroud, None)
+            dev = max(dev, edge_deviation(shroud, strings["upper"], None, None)[0])
+        if dev <= tolerance or n_c >= MAX_CAP_PATCHES:
+            return PatchString(strings["lower"], strings["upper"]), dev
+        n_c *= 2
+
+
+def junction_kinks(blade: BladeSurfaces, samples: int = 11) -> dict:
+    """Largest angle (deg) between the normals of S or P and the adjoining end cap along
+    each junction ruling: {"LE-P", "LE-S", "TE-S", "TE-P"} for the caps present."""
+    out = {}
+    v = np.linspace(0.0, 1.0, samples)
+
+    def normal(ps: PatchString, U):
+        du = ps.derivatives_u(np.full_like(v, U), v, 1)[1]
+        dv = ps.evaluate(np.full_like(v, U), np.ones_like(v)) - ps.evaluate(np.full_like(v, U), np.zeros_like(v))
+        n = np.cross(du, dv)
+        return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+    for label, cap, pairs in (("LE", blade.leading_edge, (("P", 0.0, 0.0), ("S", 0.0, None))),
+                              ("TE", blade.trailing_edge, (("S", None, 0.0), ("P", None, None)))):
+        if cap is None:
+            continue
+        for (name, U_surface, U_cap) in pairs:
+            surf = blade.surface(name)
+            Us = float(surf.count) if U_surface is None else U_surface
+            Uc = float(cap.count) if U_cap is None else U_cap
+            c = np.clip(np.abs(np.sum(normal(surf, Us) * normal(cap, Uc), axis=-1)), 0.0, 1.0)
+            out[f"{label}-{name}"] = float(np.degrees(np.max(np.arccos(c))))
+    return out
 
 
 def build_blade(
@@ -333,41 +632,59 @@ def build_blade(
     axial_elements: bool = False,
     leading_edge_ratio: float = 0.0,
     trailing_edge_ratio: float = 0.0,
+    tolerance: float = 0.0,
+    wall_tolerance: float | None = None,
+    spacing: str = "meridional",
 ) -> BladeSurfaces:
-    """B, S and P of one blade (module docstring, steps a–g)."""
+    """B, S, P and the end caps of one blade (module docstring, steps a–g).
+
+    tolerance: camber (rθ) and S/P offset tolerance in metres; > 0 makes the patch count
+    adaptive: from ``n_patches`` it is raised (predicted from the h^4 convergence of the
+    cubic spline) until the edges of B, S and P lie on the walls within ``wall_tolerance``
+    (default: ``tolerance``) and follow steps c–d within ``tolerance``; 0 uses
+    ``n_patches`` as given. The caps are fitted to the smaller of the two. The result's
+    ``report`` holds the counts, the measured deviations (m) and whether they were met:
+    a count that reaches MAX_PATCHES without meeting them is reported, not refused."""
     if n_patches < 1:
         raise GeometryError(f"a blade needs at least one patch, got {n_patches}")
-    U_hub = corner_parameters(hub, n_patches)
-    strings = {}
-    imposed = {}
-    walls = [(hub, U_hub, "lower")]
-    if not axial_elements:
-        U_shroud = corner_parameters(shroud, n_patches)
-        walls.append((shroud, U_shroud, "upper"))
-    for name, side in (("B", 0.0), ("S", -1.0), ("P", 1.0)):
-        angles = np.zeros((2, 2))
-        for w, (wb, U, which) in enumerate(walls):
-            X, dX, ang = _surface_state(wb, U, side)
-            angles[w] = ang[[0, -1]]
-            m = wb.camber.m(U)
-            dm = np.diff(m)
-            strings[(name, which)] = cubic_string_through(X, dX[0] * dm[0], dX[-1] * dm[-1])
-        imposed[name] = angles
-    if axial_elements:
-        for name in ("B", "S", "P"):
-            strings[(name, "upper")] = _axial_shroud(channel, strings[(name, "lower")], shroud, U_hub)
-        U_shroud = np.full_like(U_hub, np.nan)
-        for name in ("B", "S", "P"):
-            imposed[name][1] = np.nan  # the shroud angles follow from the hub
-    surfaces = {name: PatchString(strings[(name, "lower")], strings[(name, "upper")]) for name in ("B", "S", "P")}
-    d_hub = bernstein_function(hub.thickness, np.array([0.0, 1.0]))
-    d_shroud = bernstein_function((hub if axial_elements else shroud).thickness, np.array([0.0, 1.0]))
-    le = rounded_end_patch(surfaces["P"], surfaces["S"], 0, leading_edge_ratio, leading_edge_ratio, d_hub[0], d_shroud[0]) \
-        if min(d_hub[0], d_shroud[0]) > 0.0 else None
-    te = rounded_end_patch(surfaces["S"], surfaces["P"], 1, trailing_edge_ratio, trailing_edge_ratio, d_hub[1], d_shroud[1]) \
-        if min(d_hub[1], d_shroud[1]) > 0.0 else None
+    if spacing not in PATCH_SPACINGS:
+        raise GeometryError(f"patch spacing must be one of {PATCH_SPACINGS}, got {spacing!r}")
+    tol = float(tolerance)
+    wall_tol = tol if wall_tolerance is None else float(wall_tolerance)
+    n = int(n_patches)
+    while True:
+        surfaces, imposed, U_hub, U_shroud = _wall_strings(channel, hub, shroud, n, axial_elements, spacing)
+        dev = _deviations(hub, shroud, surfaces, U_hub, U_shroud, axial_elements)
+        if tol <= 0.0:
+            break
+        ratio = max(dev["wall_gap"] / wall_tol, dev["camber"] / tol, dev["thickness"] / tol)
+        if ratio <= 1.0 or n >= MAX_PATCHES:
+            break
+        n = min(MAX_PATCHES, max(n + 1, int(np.ceil(n * ratio ** 0.25 * PATCH_MARGIN))))
+    cap_tol = min(tol, wall_tol) if tol > 0.0 else np.inf
+    caps, cap_dev = {}, {}
+    for end, ratio_e in ((0, leading_edge_ratio), (1, trailing_edge_ratio)):
+        d_hub = float(bernstein_function(hub.thickness, np.array([float(end)]))[0])
+        d_shroud = float(bernstein_function((hub if axial_elements else shroud).thickness, np.array([float(end)]))[0])
+        if min(d_hub, d_shroud) <= 0.0:
+            caps[end] = None
+            continue
+        speeds = {"lower": _end_speed(hub, U_hub, spacing)[end]}
+        if not axial_elements:
+            speeds["upper"] = _end_speed(shroud, U_shroud, spacing)[end]
+        caps[end], cap_dev[end] = end_cap(channel, hub, shroud, surfaces, end, ratio_e, axial_elements, speeds,
+                                          cap_tol)
+    report = dict(dev)
+    report.update({
+        "patches": n, "spacing": spacing, "tolerance": tol, "wall_tolerance": wall_tol,
+        "cap_patches": tuple(None if caps[e] is None else caps[e].count for e in (0, 1)),
+        "cap_deviation": max(cap_dev.values(), default=0.0),
+    })
+    report["met"] = tol <= 0.0 or (dev["wall_gap"] <= wall_tol and dev["camber"] <= tol and dev["thickness"] <= tol
+                                   and report["cap_deviation"] <= cap_tol)
     return BladeSurfaces(
-        surfaces["B"], surfaces["S"], surfaces["P"], le, te, np.vstack([U_hub, U_shroud]), imposed, axial_elements
+        surfaces["B"], surfaces["S"], surfaces["P"], caps[0], caps[1], np.vstack([U_hub, U_shroud]), imposed,
+        axial_elements, report,
     )
 
 

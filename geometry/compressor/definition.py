@@ -27,8 +27,11 @@ Format (lengths in metres, angles in degrees; see README "Impeller definition"):
     lean_hub = 0.0                 # φ of the camber LE on hub and shroud (deg)
     lean_shroud = 0.0
     elements = "arbitrary"         # or "axial" (Casey's axial-element blades)
-    leading_edge_ratio = 3.0       # rounded LE: ellipse semi-axes ratio; 0 = not rounded
+    leading_edge_ratio = 3.0       # rounded LE: ellipse semi-axes ratio; 0 = cut off (flat closing face)
     trailing_edge_ratio = 0.0
+    tolerance = 1e-6               # camber/thickness tolerance, fraction of the outer diameter;
+                                   # the patch count is raised from `patches` to meet it (0: fixed)
+    patch_spacing = "meridional"   # or "blade": corners equidistant along the blade (Casey step e)
 
     [splitter]                     # optional: a shortened copy of the main camber line
     leading_edge_hub = 1.6
@@ -53,7 +56,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import DefinitionError, GeometryError
-from .blade import MAX_BETA_DEG, BladeSurfaces, WallBlade, WallCamber, build_blade
+from .blade import (DEFAULT_TOLERANCE, MAX_BETA_DEG, PATCH_SPACINGS, WALL_TOLERANCE, BladeSurfaces, WallBlade,
+                    WallCamber, build_blade, outer_diameter)
 from .channel import MeridionalChannel, WallSkeleton, channel_from_skeleton
 from .standardisation import Standardisation
 from .uses import CutError, scaled_channel
@@ -156,7 +160,12 @@ class ChannelDefinition:
 BLADE_SCALARS = {
     "leading_edge_hub": None, "leading_edge_shroud": None, "trailing_edge_hub": None, "trailing_edge_shroud": None,
     "lean_hub": 0.0, "lean_shroud": 0.0, "leading_edge_ratio": 3.0, "trailing_edge_ratio": 0.0,
+    "tolerance": DEFAULT_TOLERANCE,
 }
+#: [blade] keys added by issue 18 (adaptive patch count, Casey's two patch spacings):
+#: "tolerance" (in BLADE_SCALARS, a fraction of the outer diameter, >= 0) and
+#: "patch_spacing" (one of PATCH_SPACINGS).
+BLADE_CHOICES = {"elements": ("arbitrary", "axial"), "patch_spacing": PATCH_SPACINGS}
 
 
 @dataclass(frozen=True)
@@ -176,6 +185,8 @@ class BladeDefinition:
     elements: str = "arbitrary"
     leading_edge_ratio: float = 3.0
     trailing_edge_ratio: float = 0.0
+    tolerance: float = DEFAULT_TOLERANCE
+    patch_spacing: str = "meridional"
 
     @classmethod
     def from_dict(cls, data: dict, path=None) -> "BladeDefinition":
@@ -186,14 +197,19 @@ class BladeDefinition:
         patches = data.get("patches", 6)
         if isinstance(patches, bool) or not isinstance(patches, int) or patches < 1:
             raise DefinitionError(f"expected a positive integer, got {patches!r}", path=path, field="blade.patches")
-        elements = data.get("elements", "arbitrary")
-        if elements not in ("arbitrary", "axial"):
-            raise DefinitionError(f"expected \"arbitrary\" or \"axial\", got {elements!r}", path=path, field="blade.elements")
+        choices = {}
+        for key, allowed in BLADE_CHOICES.items():
+            choices[key] = data.get(key, allowed[0])
+            if choices[key] not in allowed:
+                raise DefinitionError(f"expected one of {', '.join(map(repr, allowed))}, got {choices[key]!r}",
+                                      path=path, field=f"blade.{key}")
         values = {k: _number(data, k, s, path, d) for k, d in BLADE_SCALARS.items()}
+        if values["tolerance"] < 0.0:
+            raise DefinitionError(f"expected a number >= 0, got {values['tolerance']!r}", path=path, field="blade.tolerance")
         for w in WALLS:
             values[f"beta_{w}"] = _floats(data, f"beta_{w}", s, path)
             values[f"thickness_{w}"] = _floats(data, f"thickness_{w}", s, path)
-        return cls(count=count, patches=patches, elements=elements, **values)
+        return cls(count=count, patches=patches, **choices, **values)
 
     def to_dict(self) -> dict:
         out = {}
@@ -429,7 +445,11 @@ class ImpellerDefinition:
             w: WallBlade(cambers[w], cambers[w].U0, cambers[w].U1, np.asarray(getattr(b, f"thickness_{w}")))
             for w in WALLS
         }
-        blade = build_blade(channel, walls["hub"], walls["shroud"], b.patches, axial, b.leading_edge_ratio, b.trailing_edge_ratio)
+        size = outer_diameter(walls["hub"], walls["shroud"])
+        tol = b.tolerance * size
+        wall_tol = min(b.tolerance, WALL_TOLERANCE) * size if b.tolerance > 0.0 else None
+        blade = build_blade(channel, walls["hub"], walls["shroud"], b.patches, axial, b.leading_edge_ratio,
+                            b.trailing_edge_ratio, tol, wall_tol, b.patch_spacing)
         splitter = None
         s = self.splitter
         if s is not None:
@@ -439,7 +459,8 @@ class ImpellerDefinition:
                              np.asarray(getattr(s, f"thickness_{w}")), offset)
                 for w in WALLS
             }
-            splitter = build_blade(channel, swalls["hub"], swalls["shroud"], s.patches, axial, s.leading_edge_ratio, b.trailing_edge_ratio)
+            splitter = build_blade(channel, swalls["hub"], swalls["shroud"], s.patches, axial, s.leading_edge_ratio,
+                                   b.trailing_edge_ratio, tol, wall_tol, b.patch_spacing)
         st = self.standardisation
         if st is None or st.is_identity:
             return ImpellerModel(self.name, channel, blade, splitter, b.count)

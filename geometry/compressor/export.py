@@ -49,16 +49,34 @@ def ruled_bspline(surface: PatchString) -> BSplineSurface:
     lo = _reduced_string(surface.lower, 1)
     up = _reduced_string(surface.upper, 1)
     if lo is None or up is None:
-        return surface.to_bspline()
+        # a fitted string (:mod:`.fitting`) is C2 in its own knot spans, not in unit spans
+        # per patch: take the spans from the polygon legs at the junctions (C1 matching)
+        h = _spans(surface.lower)
+        lo = _reduced_string(surface.lower, 1, spans=h) if h is not None else None
+        up = _reduced_string(surface.upper, 1, spans=h) if h is not None else None
+        if lo is None or up is None:
+            return surface.to_bspline()
     P = np.stack([lo.control_points, up.control_points], axis=1)
     return BSplineSurface(lo.degree, 1, lo.knots, np.array([0.0, 0, 1, 1]), P)
 
 
-def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
-    """A wall of revolution as four quarter surfaces (φ in [qπ/2, (q+1)π/2]), each one
-    exact rational quadratic arc in v, so that none is closed and none has a C0 knot in v, with the contour made C1 by choosing the knot spans so that the first
-    derivatives match at the junctions (the channel is G2; interior knots of
-    multiplicity p - 1), falling back to the Bézier form."""
+def _spans(string: BezierString):
+    """Knot spans that make the string's first derivatives match at the junctions, or None."""
+    h = [1.0]
+    for a, b in zip(string.segments[:-1], string.segments[1:]):
+        da = np.linalg.norm(a.control_points[-1] - a.control_points[-2])
+        db = np.linalg.norm(b.control_points[1] - b.control_points[0])
+        if not (da > 0.0 and db > 0.0):
+            return None
+        h.append(h[-1] * db / da)
+    return h
+
+
+def reduced_contour(string: BezierString):
+    """The wall contour as a C1 B-spline (interior knots of multiplicity p - 1, knot spans
+    chosen so that the first derivatives match at the junctions: the channel is G2), or
+    the Bézier form when that fails; and the parameter breaks of the channel patches
+    (patch j covers [breaks[j], breaks[j+1]], linearly in U)."""
     p = string.max_degree
     s = string.elevated_to(p)
     h = [1.0]
@@ -68,7 +86,16 @@ def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
         h.append(h[-1] * db / da)
     contour = _reduced_string(s, p - 1, spans=h) if p > 1 else None
     if contour is None:
-        contour = string.to_bspline()
+        return string.to_bspline(), np.arange(string.count + 1, dtype=float)
+    return contour, np.r_[0.0, np.cumsum(h)]
+
+
+def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
+    """A wall of revolution as four quarter surfaces (φ in [qπ/2, (q+1)π/2]), each one
+    exact rational quadratic arc in v, so that none is closed and none has a C0 knot in v, with the contour made C1 by choosing the knot spans so that the first
+    derivatives match at the junctions (the channel is G2; interior knots of
+    multiplicity p - 1), falling back to the Bézier form."""
+    contour, _ = reduced_contour(string)
     knots_c, circle, w_circle = full_circle()
     out = []
     for q in range(4):
@@ -87,9 +114,9 @@ def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
 def blade_surfaces(blade, include_camber: bool = False) -> list[tuple[str, BSplineSurface]]:
     out = [("S", ruled_bspline(blade.suction)), ("P", ruled_bspline(blade.pressure))]
     if blade.leading_edge is not None:
-        out.append(("LE", blade.leading_edge.to_bspline()))
+        out.append(("LE", ruled_bspline(blade.leading_edge)))
     if blade.trailing_edge is not None:
-        out.append(("TE", blade.trailing_edge.to_bspline()))
+        out.append(("TE", ruled_bspline(blade.trailing_edge)))
     if include_camber:
         out.append(("B", ruled_bspline(blade.camber)))
     return out
@@ -124,3 +151,21 @@ def impeller_surfaces(model: ImpellerModel, blades: int | None = None, include_c
                     surface.control_points @ R.T, surface.weights)
                 out.append((f"{label} {k + 1} {part}", turned))
     return out
+
+
+def construction_summary(model: ImpellerModel) -> tuple[str, bool]:
+    """One line on the adaptive construction of the blades (:func:`.blade.build_blade`):
+    patches chosen, the largest edge-to-wall distance and the camber and thickness errors
+    (metres); and whether every tolerance was met."""
+    parts, met = [], True
+    for label, blade in (("blade", model.blade), ("splitter", model.splitter)):
+        if blade is None or not blade.report:
+            continue
+        r = blade.report
+        met = met and bool(r.get("met", True))
+        parts.append(f"{label} {r['patches']} patches ({r['spacing']}), wall {r['wall_gap']:.2g} m, "
+                     f"camber {r['camber']:.2g} m, thickness {r['thickness']:.2g} m")
+    text = "; ".join(parts)
+    if not met:
+        text = "tolerance NOT met: " + text
+    return text, met

@@ -53,6 +53,9 @@ DEFAULT_TOLERANCE = 1e-7
 #: Initial knot spans per master patch (the patch junctions are knots from the start;
 #: fewer only means more rounds of knot insertion, the final knots are about the same).
 INITIAL_SPANS = 4
+#: ... for a master of up to this many patches; an adaptive master with more patches starts
+#: from its patch junctions alone (its patches are already short).
+INITIAL_SPANS_PATCHES = 8
 #: Samples per knot span when measuring the edges' distance from the walls.
 WALL_CHECK_SAMPLES_PER_SPAN = 8
 #: Foot-point Newton: iterations and step tolerance (in the wall parameter).
@@ -124,7 +127,7 @@ def trim_surface(surface, channel: MeridionalChannel, tolerance: float, name: st
     try:
         hub, shroud = approximate_common(
             [_remembered(exact, "hub"), _remembered(exact, "shroud")],
-            tolerance, degree=3, domain=(0.0, float(n)), initial_knots=np.arange(1, INITIAL_SPANS * n) / INITIAL_SPANS,
+            tolerance, degree=3, domain=(0.0, float(n)), initial_knots=np.arange(1, _spans(n) * n) / _spans(n),
             report=report, seed_knots=_LAST_KNOTS.get(key))
     except CutError as exc:
         raise CutError(f"{name}: {exc}" if name else str(exc), exc.wall, exc.U) from None
@@ -137,6 +140,11 @@ def trim_surface(surface, channel: MeridionalChannel, tolerance: float, name: st
     trimmed = BSplineSurface(3, 1, hub.knots, np.array([0.0, 0.0, 1.0, 1.0]), P)
     return TrimmedSurface(name, trimmed, exact, tuple(report["max_deviation"]),
                           edge_wall_deviation(trimmed, exact), len(hub.knots))
+
+
+def _spans(n: int) -> int:
+    return max(1, (INITIAL_SPANS * INITIAL_SPANS_PATCHES) // max(n, INITIAL_SPANS_PATCHES) if n > INITIAL_SPANS_PATCHES
+               else INITIAL_SPANS)
 
 
 def _remembered(exact: StandardisedSurface, which: str):

@@ -28,7 +28,7 @@ the N redistributed points is periodic (knots wrap around by the period, the las
 of N + 3 control points repeat the first three, :func:`periodic_spline_through`), the
 curvature smoother wraps around, every control point moves and the Jacobian is cyclic
 tridiagonal (Sherman–Morrison on ``solve_banded``, :func:`solve_cyclic_tridiagonal`).
-Because nothing is pinned, κ* is shifted to keep ∮κ ds (:func:`_keep_turning`) and the
+Because nothing is pinned, κ* is corrected to keep ∮κ ds and closure (:func:`_keep_turning`) and the
 result is moved back by the best rigid motion (:func:`_rigid_align`).
 
 smoothfoil (§3.3 "Airfoil preparation", §3.2.1) works at unit chord with a sharp trailing
@@ -56,7 +56,6 @@ from ..files import atomic_write
 from ..errors import DefinitionError, GeometryError
 from ..nurbs import BSplineCurve, closest_point_curve, split
 from ..nurbs.basis import basis_function_derivatives, basis_functions, find_span
-from ..sections.airfoil_file import Airfoil
 from .curvature import arclength_table, curvature_at, derivatives, params_at_arclength, span_samples
 from .distributions import DistributionReport, PolynomialDistribution, curvature_fractions, distribution_report
 
@@ -74,6 +73,20 @@ DIVERGENCE_FACTOR = 1e3
 #: smooth2D treats a curve as closed when its two ends are this close (relative to the
 #: bounding-box diagonal): float32 coordinates (Blender) round at ~6e-8.
 CLOSED_TOL = 1e-6
+
+#: The iteration is stationary, and counts as converged, when Σ|κ − κ*| changes by less
+#: than STATIONARY_CHANGE of itself between iterations and is below STATIONARY_FRACTION of
+#: the first residual (e.g. a noisy cylinder read as a closed curve, α = 1: 32.4 → 0.257, then
+#: constant to 7 digits with steps of 4e-10, just above tolx = 1e-10).
+STATIONARY_CHANGE = 1e-3
+STATIONARY_FRACTION = 5e-2
+
+#: Ends that meet at an angle larger than this (degrees) make a corner, not a closed
+#: curve: a sharp airfoil trailing edge read by smooth2D is an open curve whose ends
+#: coincide. Smoothed as a periodic cubic its corner would become a curvature spike of
+#: ~1e4 that no smoothing can follow.
+CORNER_ANGLE_DEG = 5.0
+CORNER_TURN_RATIO = 3.0
 
 #: Trailing-edge gap (fraction of chord) below which an airfoil counts as sharp.
 SHARP_TE_TOL = 1e-9
@@ -99,6 +112,14 @@ PARALLEL_TANGENT_TOL = 1e-12
 DEVIATION_SAMPLES_PER_SPAN = 4
 #: Bracketing samples per knot span of the projections behind the true deviation.
 DEVIATION_BRACKET_SAMPLES = 4
+
+#: Smoothing type 2 keeps the largest |κ| only when it is a peak that survives
+#: smoothing: after PEAK_PROBE_PASSES ad hoc passes the largest |κ| is still PEAK_RATIO
+#: times the median |κ| or more. Measured on the shipped airfoils at 180 points: 4.7
+#: (DU 40) to 70 (fx66-s-196); the NREL cylinders 1.5 (their largest raw value, 3.8 times
+#: the median, is one noisy point near the leading edge).
+PEAK_RATIO = 3.0
+PEAK_PROBE_PASSES = 4
 
 #: Weight of the kept maximum in the least-squares smoother of smoothing type 2 (relative
 #: to 1 for every other point): large enough to pin the fit to the value.
@@ -402,6 +423,16 @@ def _end_moment_correction(change: np.ndarray) -> np.ndarray:
     return out
 
 
+def has_peak(kappa, closed: bool = False) -> bool:
+    """Does κ have a peak for smoothing type 2 to keep (:data:`PEAK_RATIO`)?"""
+    k = np.asarray(kappa, dtype=np.float64)
+    probe = k
+    for _ in range(PEAK_PROBE_PASSES):
+        padded = _extend(probe, 1, closed)
+        probe = (padded[:-2] + padded[1:-1] + padded[2:]) / 3.0
+    return float(np.max(np.abs(probe))) >= PEAK_RATIO * float(np.median(np.abs(k)))
+
+
 def smooth_curvature(
     kappa,
     smoother: str = "ad_hoc",
@@ -430,12 +461,16 @@ def smooth_curvature(
     :data:`LS_END_PAD` values wrapped around beyond each end, so the fit is periodic to
     round-off and the seam leaves no trace.
     smoothing_type 2 keeps κ at the point of largest |κ| (the airfoil's leading edge,
-    §3.4 "smttype"); type 1 smooths every point.
+    §3.4 "smttype") when it is a peak (:data:`PEAK_RATIO`); type 1 smooths every point.
     """
     k = np.array(kappa, dtype=np.float64)
     n = k.size
     keep = int(np.argmax(np.abs(k)))
     kept = k[keep]
+    if smoothing_type == 2 and not has_peak(k, closed):
+        # no peak to keep (a cylinder section: the largest value is one noisy point, and
+        # keeping it bent the circle by 2.4e-2 c): smooth every point
+        smoothing_type = 1
     if smoother == "ad_hoc":
         for _ in range(int(passes)):
             padded = _extend(k, 1, closed)
@@ -543,6 +578,7 @@ def newton_curvature(
 
     history: list[tuple[float, float]] = []
     first = None
+    target = np.array(target, dtype=np.float64)
     for iteration in range(1, int(max_iterations) + 1):
         kappa = op.curvature(P)
         residual = kappa - target
@@ -553,6 +589,12 @@ def newton_curvature(
             history.append((errf, 0.0))
             return build(P), history, True, "tolf"
         first = errf if first is None else first
+        if history and abs(history[-1][0] - errf) <= STATIONARY_CHANGE * errf and errf <= STATIONARY_FRACTION * first:
+            # the curve no longer moves and what is left of κ* − κ is a small part of what
+            # was asked: the part of the target no displacement reaches (round-off in the
+            # cokernel of J); more iterations would only repeat this one
+            history.append((errf, 0.0))
+            return build(P), history, True, "stationary"
         if errf > DIVERGENCE_FACTOR * first:
             history.append((errf, float("nan")))
             return build(P), history, False, "the residual diverged"
@@ -563,6 +605,21 @@ def newton_curvature(
         except np.linalg.LinAlgError:
             history.append((errf, float("nan")))
             return build(P), history, False, "the Jacobian is singular"
+        if closed:
+            delta = _without_rigid_modes(delta, P[rows], normals)
+        if np.max(np.abs(delta)) > MAX_STEP:
+            # The step asks for more than the curve can give: κ* − κ has a part along J's
+            # weakest direction, which no reasonable displacement produces (ends at one
+            # point, e.g. a cylinder read as an airfoil: the turn about that point, which
+            # curvature cannot see). Take that part out of κ* (the least change of the
+            # target that makes it reachable) and solve again.
+            y = _weakest_left_vector(bands, closed)
+            shift = y * float(y @ residual)
+            target = target + shift
+            residual = residual - shift
+            delta = _solve_jacobian(bands, -residual, closed)
+            if closed:
+                delta = _without_rigid_modes(delta, P[rows], normals)
         errx = float(np.sum(np.abs(delta)))
         history.append((errf, errx))
         if not np.all(np.isfinite(delta)) or np.max(np.abs(delta)) > MAX_STEP:
@@ -577,6 +634,33 @@ def newton_curvature(
             history.append((float(np.sum(np.abs(kappa - target))), 0.0))
             return build(P), history, True, "tolx"
     return build(P), history, False, f"ntrial = {max_iterations} iterations reached"
+
+
+def _weakest_left_vector(bands: np.ndarray, closed: bool = False, iterations: int = 4) -> np.ndarray:
+    """Unit left singular vector of the smallest singular value of the (cyclic, when
+    ``closed``) tridiagonal J (``bands`` as in :func:`_jacobian_bands`), by inverse
+    iteration on Jᵀ: Jᵀ[i, i−1] = J[i−1, i] = bands[2, i−1], Jᵀ[i, i+1] = J[i+1, i] =
+    bands[0, i+1]."""
+    transposed = np.stack([np.roll(bands[2], 1), bands[1], np.roll(bands[0], -1)])
+    y = np.random.default_rng(0).standard_normal(bands.shape[1])
+    for _ in range(iterations):
+        y = _solve_jacobian(transposed, y, closed)
+        y /= np.linalg.norm(y)
+    return y
+
+
+def _without_rigid_modes(delta: np.ndarray, vertices: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """``delta`` less its least-squares component along the normal displacements of the
+    rigid motions of a closed curve (the two translations and the turn about the
+    centroid). Rigid motions leave every κ_i unchanged, so the cyclic J is (nearly)
+    singular along them and round-off in the finite-difference Jacobian (§3.2 step 3)
+    grows there from one iteration to the next: on a Blender Bezier circle the residual
+    fell to 7e-9 and then rose tenfold per iteration. Removing them changes J δ only to
+    first order in the round-off."""
+    arm = vertices - vertices.mean(axis=0)
+    M = np.stack([normals[:, 0], normals[:, 1], normals[:, 1] * arm[:, 0] - normals[:, 0] * arm[:, 1]], axis=1)
+    coef, *_ = np.linalg.lstsq(M, delta, rcond=None)
+    return delta - M @ coef
 
 
 # =======================================================================================
@@ -732,16 +816,24 @@ def _run(
 
 
 def _keep_turning(target: np.ndarray, kappa: np.ndarray, curve: BSplineCurve, params: np.ndarray) -> np.ndarray:
-    """κ* shifted by a constant so that it turns the tangent as far as κ does around the
-    loop (∮κ ds = 2π for a simple closed curve; trapezoidal rule over the knots, arc
-    lengths of ``curve``). Smoothing in the point index does not conserve ∮κ ds when the
-    points are not evenly spaced, and a closed curve cannot absorb the difference at free
-    ends: it would bend its whole shape to meet κ* at the knots."""
+    """κ* corrected so that a closed curve can still follow it: it must turn the tangent
+    as far as κ does around the loop (∮κ ds = 2π) and bring the curve back to its start.
+    To first order a change Δκ of a closed curve's curvature moves its end by
+    ∮ Δκ(s) J (r(L) − r(s)) ds, so with ∮Δκ ds = 0 closure asks ∮ Δκ(s) r(s) ds = 0: three
+    linear conditions. κ* gets the least correction c(s) = d + a x(s) + b y(s) that meets
+    them (trapezoidal rule over the knots, arc lengths of ``curve``). Smoothing in the point
+    index meets none of them when the points are not evenly spaced, and type 2's kept
+    maximum breaks the symmetry that would otherwise meet the closure ones; a closed
+    curve has no free end to absorb the difference and would bend its whole shape."""
     t, s = arclength_table(curve)
     knots_s = np.interp(np.concatenate([params, [curve.domain[1]]]), t, s)
     ds = np.diff(knots_s)
     w = 0.5 * (ds + np.roll(ds, 1))  # trapezoid weights of the periodic knots
-    return target + float(np.sum(w * (kappa - target))) / float(np.sum(w))
+    r = curve.evaluate(params)
+    B = np.column_stack([np.ones_like(w), r - np.sum(w[:, None] * r, axis=0) / np.sum(w)])
+    change = target - kappa
+    coef = np.linalg.solve(B.T @ (w[:, None] * B), -B.T @ (w * change))
+    return target + B @ coef
 
 
 def _rigid_align(curve: BSplineCurve, reference: BSplineCurve, params: np.ndarray) -> BSplineCurve:
@@ -758,10 +850,42 @@ def _rigid_align(curve: BSplineCurve, reference: BSplineCurve, params: np.ndarra
     return curve.with_control_points(cb + (curve.control_points - ca) @ R.T)
 
 
-def _fail(kind: str, history, reason: str):
+def advice(history, reason: str, settings: "SmoothingSettings | None" = None) -> str:
+    """What to change, read from the residual history (Σ|κ − κ*| per iteration) and the
+    reason the iteration stopped (Hvid 1993 §3.2.2: a target curvature that asks too much
+    does not converge; §3.4: ntrial, tolx, tolf)."""
+    f = np.array([h[0] for h in history], dtype=np.float64)
+    s = settings or SmoothingSettings()
+    if "non-finite" in reason:
+        return ("the curvature became infinite: the curve has a cusp, a corner or nearly repeated points; "
+                "remove them, or use more smoothing points (nsmooth) so each corner is resolved")
+    if "singular" in reason:
+        return "the Jacobian is singular: the curve folds back on itself; check the point order"
+    if f.size >= 2 and "ntrial" in reason:
+        best = int(np.argmin(f))
+        if best < f.size - 1 and f[-1] > 2.0 * f[best]:
+            return (f"the residual fell to {f[best]:.3g} at iteration {best + 1} and then rose (round-off): "
+                    f"set tolf to {10 * f[best]:.2g} or more")
+        rate = f[-1] / f[-2] if f[-2] > 0 else 1.0
+        if rate < 0.5 and f[-1] > 0:
+            more = int(np.ceil(np.log(max(s.tolf, 1e-300) / f[-1]) / np.log(rate))) if s.tolf > 0 else 10
+            return (f"the residual still falls (×{rate:.2g} per iteration, now {f[-1]:.3g}): "
+                    f"raise max_iterations (ntrial) to about {len(f) + max(more, 1) + 2}")
+        return (f"the residual stalls at {f[-1]:.3g}: the target curvature cannot be reached; "
+                "smooth less (fewer passes, or the least-squares smoother), use smoothing type 1 "
+                f"on a closed curve, or accept it with tolf = {2 * f[-1]:.2g}")
+    if "diverg" in reason or "exceeds" in reason:
+        return (f"the first residual {f[0]:.3g} asks for more than a small correction: "
+                "smooth less (fewer passes, or the least-squares smoother), use more smoothing points "
+                "(nsmooth) where the curvature changes fast (smaller α), or check for a corner in the curve"
+                if f.size else "smooth less (fewer passes)")
+    return "smooth less (fewer passes, or the least-squares smoother), or use more iterations"
+
+
+def _fail(kind: str, history, reason: str, settings: "SmoothingSettings | None" = None):
     raise SmoothingNotConverged(
-        f"{kind}: the smoothing did not converge (Hvid 1993 §3.2.2: smooth less, e.g. fewer passes, "
-        f"or use more iterations); the curve was not changed",
+        f"{kind}: the smoothing did not converge; the curve was not changed. What to change: "
+        f"{advice(history, reason, settings)}",
         history,
         reason,
     )
@@ -825,8 +949,7 @@ def smooth2d(
         raise GeometryError("smooth2D: the curve has zero extent")
     eye = np.eye(2)
     if closed is None:
-        ends = raw.evaluate(np.array(raw.domain)) if raw is not None else points[[0, -1]]
-        closed = bool(np.linalg.norm(ends[1] - ends[0]) <= CLOSED_TOL * ref)
+        closed = _closed(raw, points, ref)
     if raw is not None:
         source = _transform_curve(raw, 1.0 / ref, eye, -lo / ref)
         data_points = source.evaluate(span_samples(source, 1))
@@ -845,7 +968,7 @@ def smooth2d(
         source, fractions, output_fractions, settings, progress, closed=closed
     )
     if not converged and raise_on_failure:
-        _fail("smooth2D", history, reason)
+        _fail("smooth2D", history, reason, settings)
     deviation = _deviation(curve, unsmoothed, params, data_points, measure)
     out_fr = curvature_fractions(curve, settings.output_points, alpha)
     out_points = curve.evaluate(params_at_arclength(curve, out_fr))
@@ -874,6 +997,44 @@ def smooth2d(
 # =======================================================================================
 # smoothfoil
 # =======================================================================================
+def is_closed(data) -> bool:
+    """Would :func:`smooth2d` smooth ``data`` (points (m, 2) or a 2-D BSplineCurve) as a
+    closed curve: its ends within :data:`CLOSED_TOL` of its size and meeting without a
+    corner (:data:`CORNER_ANGLE_DEG`)?"""
+    if isinstance(data, BSplineCurve):
+        raw, points = (data, None) if data.degree >= 2 else (None, _as_points(data.control_points, "curve control points"))
+    else:
+        raw, points = None, _as_points(data, "points")
+    sample = raw.evaluate(span_samples(raw, 4)) if raw is not None else points
+    return _closed(raw, points, float(np.linalg.norm(np.ptp(sample, axis=0))))
+
+
+def _closed(raw: BSplineCurve | None, points: np.ndarray | None, size: float) -> bool:
+    ends = raw.evaluate(np.array(raw.domain)) if raw is not None else points[[0, -1]]
+    return bool(np.linalg.norm(ends[1] - ends[0]) <= CLOSED_TOL * size) and not _corner_at_join(raw, points)
+
+
+def _corner_at_join(raw: BSplineCurve | None, points: np.ndarray | None) -> bool:
+    """Do the two ends of a curve whose ends coincide meet in a corner? A curve's end
+    tangents at more than :data:`CORNER_ANGLE_DEG`; points: the turn between the last and
+    the first chord both above that angle and more than :data:`CORNER_TURN_RATIO` times the
+    turn at either neighbouring point (a closed outline turns by about the same angle at
+    every point; a sharp trailing edge turns by much more at the join than next to it)."""
+    def turn(a, b):
+        na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+        if na == 0.0 or nb == 0.0:
+            return np.pi
+        return float(np.arccos(np.clip(np.dot(a, b) / (na * nb), -1.0, 1.0)))
+
+    limit = np.radians(CORNER_ANGLE_DEG)
+    if raw is not None:
+        return turn(raw.derivatives(raw.domain[0], 1)[1], raw.derivatives(raw.domain[1], 1)[1]) > limit
+    c = np.diff(points, axis=0)
+    at_join = turn(c[-1], c[0])
+    beside = max(turn(c[0], c[1]), turn(c[-2], c[-1]))
+    return at_join > limit and at_join > CORNER_TURN_RATIO * beside
+
+
 def _farthest_point(curve: BSplineCurve, origin: np.ndarray) -> float:
     """Parameter of the point of ``curve`` farthest from ``origin`` (the leading edge seen
     from the trailing edge): dense samples, then Newton on (C − T)·C' = 0."""
@@ -961,7 +1122,7 @@ def smoothfoil(
 ) -> SmoothingResult:
     """Hvid's smoothfoil (1993 §3.2.1, §3.3, §3.4): smooth an airfoil outline.
 
-    data: an :class:`Airfoil` (taken lower side first, TE → lower → LE → upper → TE, the
+    data: an ``Airfoil`` of ``sections.airfoil_file`` (taken lower side first, TE → lower → LE → upper → TE, the
     order of the paper's fx66 file, so f(½) = 0.491 puts the leading edge at the middle
     point), or (m, 2) outline points TE → LE → TE in either direction and at any chord,
     position and angle (§3.3: smoothed at unit chord, mapped back).
@@ -972,7 +1133,9 @@ def smoothfoil(
     """
     settings = settings or SmoothingSettings()
     distribution = distribution or PolynomialDistribution(0.5, 0.5, 0.491, 0.1)
-    if isinstance(data, Airfoil):
+    # an Airfoil (sections/airfoil_file.py) by its sides: importing the class would make
+    # the two modules import each other (airfoil_file smooths with this one)
+    if hasattr(data, "lower") and hasattr(data, "upper"):
         points = np.concatenate([data.lower[::-1], data.upper[1:]])
     else:
         points = _as_points(data, "airfoil outline")
@@ -1014,7 +1177,7 @@ def smoothfoil(
         source, fractions, output_fractions, settings, progress, rescale_chord if rescale else None
     )
     if not converged and raise_on_failure:
-        _fail("smoothfoil", history, reason)
+        _fail("smoothfoil", history, reason, settings)
     u_out = params_at_arclength(curve, output_fractions)
     out_points = curve.evaluate(u_out)
     cut = curve

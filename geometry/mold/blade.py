@@ -223,6 +223,35 @@ def root_transition(root_nets, aero: BSplineSurface, w, scale: float, degree_w: 
     return BSplineSurface(aero.degree_u, q, aero.knots_u, cols[0].knots, net)
 
 
+#: Two independently solved copies of a shared row may differ by round-off only; more
+#: than this (relative to the surface size) means they are not the same row at all.
+SHARED_ROW_TOL = 1e-12
+
+
+def _with_row(surface: BSplineSurface, index, row: np.ndarray) -> BSplineSurface:
+    net = surface.control_points.copy()
+    size = max(surface.size(), 1.0)
+    if np.abs(net[index] - row).max() > SHARED_ROW_TOL * size:
+        raise GeometryError(f"a shared mold edge differs by {np.abs(net[index] - row).max():.3g} between its surfaces")
+    net[index] = row
+    return BSplineSurface(surface.degree_u, surface.degree_v, surface.knots_u, surface.knots_v, net, surface.weights)
+
+
+def share_mold_edges(upper, lower, tr_u=None, tr_l=None):
+    """Make every edge two mold surfaces share one array, copied (ARCHITECTURE: shared
+    means shared). The LE parting line is upper's last u row, copied into lower's first;
+    the joint of a root transition (w = 1) is the aero half's v = 0 column, copied into
+    the transition; the transitions' parting line likewise. Each copy replaces a row that
+    was solved separately and agrees to round-off only (checked against
+    :data:`SHARED_ROW_TOL`), which differs between CPUs and BLAS kernels."""
+    lower = _with_row(lower, 0, upper.control_points[-1].copy())
+    if tr_u is not None:
+        tr_u = _with_row(tr_u, (slice(None), -1), upper.control_points[:, 0].copy())
+        tr_l = _with_row(tr_l, (slice(None), -1), lower.control_points[:, 0].copy())
+        tr_l = _with_row(tr_l, 0, tr_u.control_points[-1].copy())
+    return upper, lower, tr_u, tr_l
+
+
 #: Trailing-edge edges closer than this everywhere (relative to the surface size) are one
 #: edge: the trailing edge is sharp and needs no base surface.
 SHARP_TE_TOL = 1e-12
@@ -589,6 +618,7 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
         # T_w(1) of the transition = scale · T_v(0) of the aero halves (G1 at the joint)
         tr_u, tr_l = shape_preserving_trailing_edge(tr_u, tr_l, w, te[: k0 + 1],
                                                     end_derivative=_te_start_derivative(upper, lower, scale))
+    upper, lower, tr_u, tr_l = share_mold_edges(upper, lower, tr_u, tr_l)
     times["skinning"] = time.perf_counter() - t0
     tick(0.65)
 

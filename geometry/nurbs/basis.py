@@ -142,7 +142,18 @@ def basis_functions(knots: np.ndarray, degree: int, u: np.ndarray, span: np.ndar
             N[..., r] = saved + right[..., r + 1] * temp
             saved = left[..., j - r] * temp
         N[..., j] = saved
+    _snap_single_basis(N)
     return N
+
+
+def _snap_single_basis(N: np.ndarray) -> None:
+    """Where only one basis function is non-zero (a clamped end, a knot of multiplicity
+    p), it is 1 by the partition of unity (NURBS Book P2.4); Alg. A2.2 computes it as
+    right · (N / right), which may round to 1 ± 1 ulp. Snap it, so that an end row of
+    a collocation or evaluation copies its control point bit for bit on every CPU."""
+    single = np.count_nonzero(N, axis=-1) == 1
+    if single.any():
+        N[single] = N[single] != 0.0
 
 
 def basis_function_derivatives(
@@ -173,6 +184,7 @@ def basis_function_derivatives(
         ndu[..., j, j] = saved
     ders = np.zeros(S + (order + 1, p + 1))
     ders[..., 0, :] = ndu[..., :, p]
+    _snap_single_basis(ders[..., 0, :])
     top = min(order, p)
     for r in range(p + 1):
         a = np.zeros(S + (2, p + 1))

@@ -203,7 +203,41 @@ def _collocation_matrix(knots: np.ndarray, degree: int, n_control: int, params: 
 
 def _solve_banded_rows(cols: np.ndarray, vals: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """Solve the square system whose row r has entries ``vals[r]`` in columns ``cols[r]``,
-    in LAPACK band storage with ``scipy.linalg.solve_banded`` (never an inverse)."""
+    in LAPACK band storage with ``scipy.linalg.solve_banded`` (never an inverse).
+
+    A row whose only non-zero entry is exactly 1 (a clamped end: N_0(u_0) = N_n(u_m) = 1,
+    NURBS Book Eq. 2.5 and §9.2.1) pins its unknown to the right-hand side *bit for bit*:
+    the unknown is copied, its column moved to the right-hand side of the other rows, and
+    only the remaining unknowns are solved for. Mathematically nothing changes; in floating
+    point it makes "the surface's end row is the section's control polygon" an identity
+    rather than an accident of the LU rounding, which differs between CPUs and BLAS kernels
+    (the red main of issue 14: a root transition's last column against the aero surface's
+    first row on an AVX-512 machine).
+    """
+    n = cols.shape[0]
+    rhs = np.asarray(rhs, dtype=np.float64)
+    nz = vals != 0.0
+    unit = (nz.sum(axis=1) == 1) & np.any(nz & (vals == 1.0), axis=1)
+    pin_rows = np.flatnonzero(unit)
+    pin_cols = cols[pin_rows][nz[pin_rows]]
+    if pin_rows.size == 0 or np.unique(pin_cols).size != pin_cols.size:
+        return _solve_band_storage(cols, vals, rhs)
+    free_col = np.ones(n, dtype=bool)
+    free_col[pin_cols] = False
+    flat = rhs.reshape(n, -1)
+    known = np.zeros_like(flat)
+    known[pin_cols] = flat[pin_rows]
+    if free_col.any():
+        c, v = cols[~unit], vals[~unit]
+        pinned_entry = ~free_col[c]
+        reduced_rhs = flat[~unit] - np.einsum("rj,rjk->rk", np.where(pinned_entry, v, 0.0), known[c])
+        new_index = np.cumsum(free_col) - 1
+        known[free_col] = _solve_band_storage(
+            np.maximum(new_index[c], 0), np.where(pinned_entry, 0.0, v), reduced_rhs)
+    return known.reshape(rhs.shape)
+
+
+def _solve_band_storage(cols: np.ndarray, vals: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     n = cols.shape[0]
     rows = np.broadcast_to(np.arange(n)[:, None], cols.shape)
     nz = vals != 0.0

@@ -124,12 +124,51 @@ def test_review_image(scene, tmp_path):
     before = snapshot(scene)
     out = cr.render_review_image([surf], str(path), panel_size=160, legend_height=60, comb_lines=0)
     assert path.stat().st_size > 1000
-    assert out["views"] == ["front", "back", "tip close-up"]
+    assert out["views"] == ["front", "back", "close-up (far end)"]
     img = bpy.data.images.load(str(path))
     try:
-        assert tuple(img.size) == (480, 220)
+        # heading (0.9 x legend height) + one row of three panels + the legend
+        assert tuple(img.size) == (480, 54 + 160 + 60)
+        px = np.array(img.pixels[:], dtype=np.float32).reshape(274, 480, 4)
+        heading = px[-54:, :, :3]
+        assert (heading.mean(axis=-1) < 0.85).sum() > 100  # the heading's text is there
     finally:
         bpy.data.images.remove(img)
     assert len(bpy.data.scenes) == 1 and bpy.context.scene == scene
     cr.clear_review(scene)
     assert snapshot(scene) == before
+
+
+def test_hub_left_out_of_the_limits_and_sequential_map(scene):
+    """A tagged hub with ten times the curvature does not set the limits (issue 21);
+    strain energy, never negative, gets limits from 0 and the sequential map."""
+    blade = surface_to_object(bump_surface(0.05), "Blade")
+    hub = surface_to_object(bump_surface(0.5), "Hub")
+    hub["bladesmith_part"] = "hub"
+    for o in (blade, hub):
+        o.select_set(True)
+    alone = cr.review_objects(scene, [blade], comb_lines=0).settings["limits"]
+    both = cr.review_objects(scene, [blade, hub], comb_lines=0).settings
+    assert both["limits"] == pytest.approx(alone) and both["excluded_from_limits"] == ["Hub"]
+    included = cr.review_objects(scene, [blade, hub], comb_lines=0, include_hub=True).settings["limits"]
+    assert included[1] > 3 * alone[1]
+    energy = cr.review_objects(scene, [blade], quantity="strain_energy", comb_lines=0)
+    lo, hi = energy.settings["limits"]
+    assert lo == 0.0 and hi > 0.0
+    mesh = bpy.data.collections[cr.REVIEW_COLLECTION].objects["Blade map"].data
+    col = np.zeros(len(mesh.vertices) * 4, dtype=np.float32)
+    mesh.color_attributes[cr.COLOUR_ATTRIBUTE].data.foreach_get("color", col)
+    rgb = col.reshape(-1, 4)[:, :3]
+    assert np.all(rgb[:, 2] - rgb[:, 0] < 0.1)  # no blue side: sequential, not diverging
+    cr.clear_review(scene)
+
+
+def test_zebra_quantity(scene):
+    surf = surface_to_object(bump_surface(0.2), "Bump")
+    result = cr.review_objects(scene, [surf], quantity="zebra", comb_lines=0, samples_per_span=12)
+    assert result.settings["limits"] == [0.0, 1.0]
+    mesh = bpy.data.collections[cr.REVIEW_COLLECTION].objects["Bump map"].data
+    v = np.zeros(len(mesh.vertices), dtype=np.float32)
+    mesh.attributes[cr.VALUE_ATTRIBUTE].data.foreach_get("value", v)
+    assert v.min() < 0.05 and v.max() > 0.95  # dark and light stripes over the bump
+    cr.clear_review(scene)

@@ -162,7 +162,7 @@ def test_standardised_impeller_exports_to_iges(impeller_modules, scene, tmp_path
     assert bpy.ops.export_scene.iges(filepath=str(path), units="MM") == {"FINISHED"}
     _, reference = _standardised_reference(root)
     written = [g for _, g in read_iges(path).to_geometry()]
-    assert len(written) == 8 + 15 * 3 + 15 * 3 + 2  # walls, S P LE of blades and splitters, B of blade 1 and splitter 1
+    assert len(written) == 8 + 15 * 4 + 15 * 4 + 2  # walls, S P LE TE of blades and splitters, B of blade 1 and splitter 1
     S = reference["blade 1 S"]
     assert any(g.shape == S.shape and np.array_equal(g.control_points, 1000.0 * S.control_points) for g in written)
     result = occ.read_with_occ(path)
@@ -375,3 +375,16 @@ def test_panel_walls_draws_bends_only(impeller_modules, scene):
     assert props["bladesmith_impeller.hub_angle[1].auto"] is True
     fractions = sorted(p for p in props if p.endswith(".fractions"))
     assert fractions == [f"bladesmith_impeller.{w}_fractions[{j}].fractions" for w in ("hub", "shroud") for j in (1, 2)]
+
+
+@pytest.mark.parametrize("name", ["HIGH_FLOW", "High_Flow", "high_flow.toml"])
+def test_presets_are_matched_without_regard_to_case(impeller_modules, scene, name):
+    # as the propeller and wind-blade presets are (issue 14)
+    assert bpy.ops.bladesmith.add_impeller(preset=name, full_wheel=False) == {"FINISHED"}
+
+
+def test_unknown_preset_is_refused_by_name(impeller_modules, scene):
+    before = len(bpy.data.objects)
+    with pytest.raises(RuntimeError, match="unknown preset 'no_such_wheel'"):
+        bpy.ops.bladesmith.add_impeller(preset="no_such_wheel")
+    assert len(bpy.data.objects) == before

@@ -103,11 +103,11 @@ def test_trimmed_blade_is_closed_and_extrapolated_when_wider(built, case):
     model = built[case]
     st = model.standardisation
     parts = st.parts["blade"]
-    # the end patch shares its end rulings with P (u = 0) and S (u = 1): the edges meet
+    # the end cap shares its end rulings with P (u = 0) and S (u at its end): the edges meet
     le, s, p = parts["LE"].surface, parts["S"].surface, parts["P"].surface
     for v in (0.0, 1.0):
         assert np.linalg.norm(le.evaluate(0.0, v) - p.evaluate(0.0, v)) < 1e-12 * st.size
-        assert np.linalg.norm(le.evaluate(1.0, v) - s.evaluate(0.0, v)) < 1e-12 * st.size
+        assert np.linalg.norm(le.evaluate(le.knots_u[-1], v) - s.evaluate(0.0, v)) < 1e-12 * st.size
     vh, vs = parts["S"].exact.bounds(np.linspace(0.0, model.blade.count, 61))
     if case[1] > 1.0:
         assert vs.max() > 1.0  # the blade is extrapolated beyond its shroud edge
@@ -224,8 +224,8 @@ def test_standardise_takes_end_patches():
     model = definition("intermediate_flow").build()
     channel = scaled_channel(model.channel, 0.8)
     st = standardise(model.blade.leading_edge, channel)
-    assert st.surface.count == 1
-    u = np.linspace(0.0, 1.0, 9)
+    assert st.surface.count == model.blade.leading_edge.count
+    u = np.linspace(0.0, st.surface.count, 9)
     X = st.evaluate(u, [0.0, 1.0])
     walls = {w: channel.wall(w).to_bspline() for w in ("hub", "shroud")}
     assert closest_point_curve(walls["hub"], meridional(X[:, 0]))[1].max() < 1e-12

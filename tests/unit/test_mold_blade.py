@@ -48,3 +48,34 @@ def test_parting_lines_lie_on_both_halves(nrel):
 def test_section_rows_are_the_fitted_sections(nrel):
     # the root transition ends on the first aerodynamic section exactly
     assert np.array_equal(nrel.transition_upper.control_points[:, -1], nrel.upper.control_points[:, 0])
+    assert np.array_equal(nrel.transition_lower.control_points[:, -1], nrel.lower.control_points[:, 0])
+
+
+def test_parting_lines_are_one_array_in_both_halves(nrel):
+    # shared means shared: bit for bit, whatever the CPU's rounding (issue 14)
+    assert np.array_equal(nrel.upper.control_points[-1], nrel.lower.control_points[0])
+    assert np.array_equal(nrel.transition_upper.control_points[-1], nrel.transition_lower.control_points[0])
+
+
+def test_shared_edges_survive_round_off_between_solves(monkeypatch):
+    """Each half and transition is solved separately; a 1-ulp difference between those
+    solves (another CPU's BLAS kernel) must not reach the shared edges (issue 14)."""
+    from bladesmith.geometry.mold import blade as blade_module
+    from bladesmith.geometry.nurbs import BSplineSurface
+
+    real_skin = blade_module.skin
+
+    direction = iter([np.inf, -np.inf, np.inf, -np.inf])
+
+    def skin_with_other_rounding(curves, degree_v, params=None):
+        s = real_skin(curves, degree_v, params=params)
+        # one ulp up for one half and down for the other, as other kernels might round
+        net = np.nextafter(s.control_points, next(direction))
+        return BSplineSurface(s.degree_u, s.degree_v, s.knots_u, s.knots_v, net)
+
+    monkeypatch.setattr(blade_module, "skin", skin_with_other_rounding)
+    m = build_blade(load_preset("NREL5MW"), single=False, fairness=False)
+    assert np.array_equal(m.upper.control_points[-1], m.lower.control_points[0])
+    assert np.array_equal(m.transition_upper.control_points[:, -1], m.upper.control_points[:, 0])
+    assert np.array_equal(m.transition_lower.control_points[:, -1], m.lower.control_points[:, 0])
+    assert np.array_equal(m.transition_upper.control_points[-1], m.transition_lower.control_points[0])

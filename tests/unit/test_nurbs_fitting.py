@@ -317,3 +317,35 @@ def test_approximate_common_seed_knots():
     # a seed that is not a clamped vector on the domain is ignored
     b = approximate_common(curves(0.5), 1e-6, domain=(0.0, 2.0), seed_knots=seed * 2)
     assert np.array_equal(b[0].control_points, first[0].control_points)
+
+
+def test_interpolation_end_control_points_are_the_end_points_bit_for_bit():
+    """Clamped interpolation: P_0 = Q_0 and P_n = Q_m as copies, with or without end
+    derivatives, so curves and surfaces that end on a shared point share it exactly on
+    every CPU (issue 14)."""
+    rng = np.random.default_rng(1414)
+    for trial in range(60):
+        m = int(rng.integers(4, 30))
+        Q = np.cumsum(rng.normal(size=(m, 3)), axis=0) * rng.uniform(1e-3, 1e3)
+        t = np.sort(rng.uniform(-5, 5, m))
+        if np.any(np.diff(t) <= 1e-9):
+            continue
+        for kw in ({}, {"end_derivative": rng.normal(size=3)}, {"start_derivative": rng.normal(size=3)},
+                   {"start_derivative": rng.normal(size=3), "end_derivative": rng.normal(size=3)}):
+            c = interpolate(Q, 3, params=t, **kw)
+            assert np.array_equal(c.control_points[0], Q[0]), (trial, kw)
+            assert np.array_equal(c.control_points[-1], Q[-1]), (trial, kw)
+
+
+def test_basis_at_clamped_ends_and_full_multiplicity_knots_is_exactly_one():
+    from bladesmith.geometry.nurbs.basis import basis_functions, basis_function_derivatives, find_span
+
+    rng = np.random.default_rng(3)
+    for trial in range(100):
+        inner = np.sort(rng.uniform(0, 1, int(rng.integers(1, 12))))
+        U = np.r_[[0.0] * 4, inner, inner[len(inner) // 2].repeat(2), [1.0] * 4]
+        U = np.sort(U)
+        u = np.array([0.0, 1.0])
+        span = find_span(U, 3, u)
+        for N in (basis_functions(U, 3, u, span), basis_function_derivatives(U, 3, u, span, 2)[:, 0]):
+            assert np.array_equal(N[0], [1.0, 0, 0, 0]) and np.array_equal(N[1], [0, 0, 0, 1.0]), trial

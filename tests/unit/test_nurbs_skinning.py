@@ -154,3 +154,21 @@ def test_transfinite_interpolation_errors():
         transfinite_interpolation(B, T[:3], L, R)
     with pytest.raises(GeometryError, match="non-finite"):
         transfinite_interpolation(B, T, L * np.nan, R)
+
+
+def test_skinned_end_rows_are_the_end_sections_bit_for_bit():
+    """The clamped end rows of a skin are its first and last sections' control polygons,
+    copied, not solved: equality that holds on every CPU (issue 14). Before the fix the
+    basis at v = 0 came out as 1 - 1 ulp on some knot vectors and the end rows were
+    solved through it."""
+    rng = np.random.default_rng(14)
+    for trial in range(40):
+        K = int(rng.integers(4, 16))
+        base = rng.normal(size=(7, 3)) * 10.0
+        sections = [BSplineCurve(3, np.r_[[0.0] * 4, 0.3, 0.55, 0.8, [1.0] * 4][:11], base + rng.normal(size=(7, 3)) * (k + 1))
+                    for k in range(K)]
+        v = np.sort(rng.uniform(0.0, 1.0, K))
+        v[0], v[-1] = rng.uniform(-2.0, 0.0), rng.uniform(1.0, 3.0)
+        s = skin(sections, 3, params=v)
+        assert np.array_equal(s.control_points[:, 0], sections[0].control_points), trial
+        assert np.array_equal(s.control_points[:, -1], sections[-1].control_points), trial
