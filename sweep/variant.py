@@ -196,6 +196,8 @@ def localised_definition(kind: str, definition: dict, base_dir: pathlib.Path, fo
 def definition_text(kind: str, definition: dict, header: str) -> str:
     if kind == "impeller":
         from ..geometry.compressor.definition import dumps_toml
+
+        header = "\n".join("# " + line for line in header.splitlines())  # written as given there
     else:
         from ..geometry.propeller.definition import dumps_toml
     return dumps_toml(definition, header)
