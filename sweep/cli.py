@@ -40,9 +40,13 @@ def main(argv=None) -> int:
     if args.workers is not None and args.workers < 1:
         print(f"sweep: --workers must be >= 1, got {args.workers}", file=sys.stderr)
         return 2
-    result = run_sweep(spec, scheduler=args.scheduler, workers=args.workers, serial=args.serial,
-                       retry_failed=args.retry_failed, stream=None if args.quiet else sys.stderr,
-                       dashboard=args.dashboard)
+    try:
+        result = run_sweep(spec, scheduler=args.scheduler, workers=args.workers, serial=args.serial,
+                           retry_failed=args.retry_failed, stream=None if args.quiet else sys.stderr,
+                           dashboard=args.dashboard)
+    except BladesmithError as exc:  # the design's values do not fit the fields (before anything is built)
+        print(f"sweep: {exc}", file=sys.stderr)
+        return 2
     print(f"{result['variants']} variants ({result['unique']} distinct): {result['skipped']} already done, "
           f"{result['built']} built now, {result['failed']} failed; {result['seconds']:.1f} s")
     print(f"metrics: {result['table']} (and metrics.csv)")

@@ -22,8 +22,9 @@ Metrics (each row also has ``key``, ``variant``, the parameter values, ``status`
 
 - propeller (Hally 2013): ``deviation_inside_m`` and ``deviation_outside_m`` (largest
   distance of the smoothed surfaces from the section-table blade inside and outside the
-  smoothing zone, §7), ``tip_irregularity`` (the smoothing report's figure when the
-  pipeline gives one, else NaN), ``tip_sign_changes`` (curvature sign changes summed over
+  smoothing zone, §7), ``tip_irregularity`` and ``tip_irregularity_ratio`` (the smoothing
+  report's figure after smoothing and its ratio to before, when the pipeline gives one,
+  else NaN: :func:`tip_irregularity`), ``tip_sign_changes`` (curvature sign changes summed over
   the tip surface's iso-curves through the tip cuts, §7: the inflections smoothing must
   not add), ``cuts_tip``/``cuts_leading_edge``/``cuts_trailing_edge``/``cuts_smoothed``,
   ``knots`` and ``control_points`` of the common knot vector (§9), ``shared_edge_gap_m``
@@ -64,7 +65,8 @@ WALL_SAMPLES_PER_PATCH = 64
 #: Samples along each blade edge for the edge-to-wall distance.
 EDGE_SAMPLES = 201
 
-PROPELLER_METRICS = ("deviation_inside_m", "deviation_outside_m", "tip_irregularity", "tip_sign_changes",
+PROPELLER_METRICS = ("deviation_inside_m", "deviation_outside_m", "tip_irregularity", "tip_irregularity_ratio",
+                     "tip_sign_changes",
                      "cuts_tip", "cuts_leading_edge", "cuts_trailing_edge", "cuts_smoothed", "knots",
                      "control_points", "shared_edge_gap_m", "blade_area_m2", "blade_volume_m3", "hub_sector_area_m2")
 WIND_METRICS = ("mvs", "strain_energy", "worst_station_deviation", "control_points")
@@ -166,6 +168,16 @@ def _number_or_nan(value) -> float:
     return out
 
 
+def tip_irregularity(report: dict) -> tuple[float, float]:
+    """(smoothed, smoothed / unsmoothed) from the smoothing report's ``tip_irregularity``
+    (a dict with "smoothed" and "ratio", or a plain number); NaN where the pipeline gives
+    none."""
+    value = report.get("tip_irregularity")
+    if isinstance(value, dict):
+        return _number_or_nan(value.get("smoothed")), _number_or_nan(value.get("ratio"))
+    return _number_or_nan(value), math.nan
+
+
 # -- definitions -------------------------------------------------------------------------
 def _relative(target: pathlib.Path, folder: pathlib.Path) -> str:
     return os.path.relpath(target, folder).replace(os.sep, "/")
@@ -257,10 +269,12 @@ def build_propeller(path: pathlib.Path, settings: dict, iges_path: pathlib.Path)
     write_propeller_iges(iges_path, model, blade, sector, units=units)
     report = blade.report
     area, volume = area_and_volume(blade.surfaces)
+    irregularity, irregularity_ratio = tip_irregularity(report)
     return {
         "deviation_inside_m": report["deviation_m"]["max_inside"],
         "deviation_outside_m": report["deviation_m"]["max_outside"],
-        "tip_irregularity": _number_or_nan(report.get("tip_irregularity")),
+        "tip_irregularity": irregularity,
+        "tip_irregularity_ratio": irregularity_ratio,
         "tip_sign_changes": tip_sign_changes(model, blade),
         "cuts_tip": report["cuts"]["tip"],
         "cuts_leading_edge": report["cuts"]["leading_edge"],

@@ -7,6 +7,7 @@ import subprocess
 import sys
 import textwrap
 
+import numpy as np
 import pytest
 
 from bladesmith.geometry.errors import DefinitionError
@@ -198,6 +199,37 @@ def test_propeller_metrics_scale_with_the_diameter(tmp_path):
     assert "-0.01" in record["error"]
 
 
+def _face(origin, e1, e2):
+    """A bilinear patch o + u e1 + v e2 (normal e1 x e2)."""
+    from bladesmith.geometry.nurbs import BSplineSurface
+
+    o, e1, e2 = (np.asarray(x, dtype=float) for x in (origin, e1, e2))
+    P = np.array([[o, o + e2], [o + e1, o + e1 + e2]])
+    return BSplineSurface(1, 1, np.array([0.0, 0.0, 1.0, 1.0]), np.array([0.0, 0.0, 1.0, 1.0]), P)
+
+
+def test_area_and_volume_of_a_box_open_on_a_vertical_side():
+    """A 1 x 2 x 3 box lifted to z in [5, 8], faces with outward S_u x S_v, the face
+    x = 0 left open (as the blade root on the hub cylinder: n_z = 0 there): area of the
+    five faces, and the whole volume."""
+    from bladesmith.sweep.variant import area_and_volume
+
+    a, b, c, z0 = 1.0, 2.0, 3.0, 5.0
+    faces = [
+        _face([a, 0, z0], [0, b, 0], [0, 0, c]),        # x = a, normal +x
+        _face([0, 0, z0], [a, 0, 0], [0, 0, c]),        # y = 0, normal -y
+        _face([0, b, z0], [0, 0, c], [a, 0, 0]),        # y = b, normal +y
+        _face([0, 0, z0], [0, b, 0], [a, 0, 0]),        # z = z0, normal -z
+        _face([0, 0, z0 + c], [a, 0, 0], [0, b, 0]),    # z = z0 + c, normal +z
+    ]
+    for f in faces:
+        centre = f.evaluate(0.5, 0.5) - np.array([a / 2, b / 2, z0 + c / 2])
+        assert np.dot(f.normal(0.5, 0.5), centre) > 0  # outward
+    area, volume = area_and_volume(faces)
+    assert area == pytest.approx(2 * a * b + 2 * a * c + b * c, rel=1e-13)
+    assert volume == pytest.approx(a * b * c, rel=1e-13)
+
+
 def test_wind_blade_metrics(tmp_path):
     spec = load_spec(write(tmp_path / "wind.toml", f"""
         base = "{DATA / 'blades' / 's823_small.toml'}"
@@ -253,3 +285,13 @@ def test_folder_finds_variants(tmp_path):
     with pytest.raises(DefinitionError, match="more than one") as info:
         find_variant(tmp_path, key="ab")
     assert info.value.field == "key"
+
+
+def test_tip_irregularity_taken_from_the_smoothing_report():
+    """Issue 15's report entry (a dict) or a plain number; NaN where there is none."""
+    from bladesmith.sweep.variant import tip_irregularity
+
+    assert tip_irregularity({"tip_irregularity": {"smoothed": 0.5, "unsmoothed": 2.0, "ratio": 0.25}}) == (0.5, 0.25)
+    value, ratio = tip_irregularity({"tip_irregularity": 3.0})
+    assert value == 3.0 and math.isnan(ratio)
+    assert all(math.isnan(x) for x in tip_irregularity({}))
