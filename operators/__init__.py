@@ -4,7 +4,7 @@ Submodules are listed in registration order; each exposes ``register``/``unregis
 """
 import importlib
 
-_SUBMODULES = ("nurbs_objects", "iges_io", "propeller", "wind_blade", "impeller", "impeller_uses", "import_airfoil", "smooth_curve", "curvature_review")
+_SUBMODULES = ("nurbs_objects", "iges_io", "propeller", "wind_blade", "impeller", "impeller_uses", "import_airfoil", "smooth_curve", "curvature_review", "sweep_variant")
 
 
 def _modules():

@@ -4,7 +4,7 @@ Submodules are listed in registration order; each exposes ``register``/``unregis
 """
 import importlib
 
-_SUBMODULES = ("dependencies", "propeller_panel", "wind_blade_panel", "impeller_panel", "review_panel", "hvid_panel")
+_SUBMODULES = ("dependencies", "propeller_panel", "wind_blade_panel", "impeller_panel", "review_panel", "hvid_panel", "sweep_panel")
 
 
 def _modules():

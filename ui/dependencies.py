@@ -35,6 +35,7 @@ SCIPY_OPERATORS = (
     "bladesmith.import_airfoil",
     "bladesmith.smooth_curve",
     "bladesmith.curvature_review",
+    "bladesmith.load_sweep_variant",
     "export_scene.iges",
     "import_scene.iges",
 )

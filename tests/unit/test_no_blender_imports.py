@@ -1,4 +1,4 @@
-"""geometry/ and iges/ never import Blender modules (ARCHITECTURE.md): checked statically
+"""geometry/, iges/ and sweep/ never import Blender modules (ARCHITECTURE.md): checked statically
 over every file, and dynamically by importing them with bpy made unimportable."""
 import ast
 import pathlib
@@ -13,7 +13,7 @@ BLENDER_MODULES = {"bpy", "mathutils", "bmesh", "gpu", "gpu_extras", "bl_ui", "b
 
 
 def python_files():
-    for folder in ("geometry", "iges"):
+    for folder in ("geometry", "iges", "sweep"):
         yield from sorted((ROOT / folder).rglob("*.py"))
 
 
