@@ -117,7 +117,7 @@ def units_of(model: IgesModel) -> Units:
     scale = 1.0 if "model_scale" in model.defaulted else float(h.model_scale)
     if not (math.isfinite(scale) and scale > 0.0):
         raise IgesError(f"{where}Global field 13 (model space scale) = {scale!r}: must be > 0", path=None)
-    name = (h.unit_name or "").strip().upper()
+    name = "" if "unit_name" in model.defaulted else (h.unit_name or "").strip().upper()
     named = UNIT_NAME_FLAGS.get(name.replace(" ", "").rstrip("."))
     flag = None if "unit_flag" in model.defaulted else int(h.unit_flag)
     if flag is None:
