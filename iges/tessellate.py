@@ -25,6 +25,8 @@ from ..geometry.errors import IgesError
 MAX_ROUNDS = 12
 #: First grid: this many cells across the larger side of the loop's bounding box.
 START_CELLS = 16
+#: Most vertices of one face's display mesh (a tolerance missed at this size is reported).
+MAX_FACE_POINTS = 20_000
 #: Edges processed at once by the point-in-polygon test (bounds the memory to
 #: points x this many booleans).
 EDGE_CHUNK = 256
@@ -82,11 +84,13 @@ def inside(points: np.ndarray, loops: list) -> np.ndarray:
     return odd
 
 
-def _resample(loop: np.ndarray, step: float) -> np.ndarray:
+def _resample(loop: np.ndarray, step: float, max_points: int) -> np.ndarray:
     """The closed polyline ``loop`` with every segment longer than ``step`` subdivided."""
     b = np.roll(loop, -1, axis=0)
     seg = np.linalg.norm(b - loop, axis=1)
-    k = np.maximum(1, np.ceil(seg / step).astype(int))
+    k = np.maximum(1, np.ceil(np.minimum(seg / step, max_points)).astype(np.int64))
+    if int(k.sum()) > max_points:
+        raise IgesError(f"meshing the trimmed face needs more than the budget of {max_points} points")
     out = [loop[i] + (b[i] - loop[i]) * (np.arange(k[i])[:, None] / k[i]) for i in range(len(loop))]
     return np.concatenate(out)
 
@@ -97,6 +101,7 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
     surface's parameter space), with chordal deviation within ``tolerance`` if the budget
     of ``max_points`` vertices allows (see :class:`TrimmedMesh`.deviation).
     IgesError when the loops bound no area."""
+    max_points = min(int(max_points), MAX_FACE_POINTS)
     loops_uv = [np.asarray(l, dtype=np.float64) for l in loops_uv if len(l) >= 3]
     if not loops_uv:
         raise IgesError("the trimming loops bound no area")
@@ -118,7 +123,7 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
     width = span * scale
     h = float(width.max()) / START_CELLS
     best = None
-    B = np.concatenate([_resample(l, h) for l in mloops])
+    B = np.concatenate([_resample(l, h, max_points) for l in mloops])
     nx, ny = (np.ceil(width / h).astype(int) + 1).tolist()
     gx = np.linspace(0.0, width[0], nx)
     gy = np.linspace(0.0, width[1], ny)
