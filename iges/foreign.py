@@ -214,7 +214,41 @@ class Solid186(Entity):
         return self.shells
 
 
-FOREIGN_TYPES = (Plane108, TabulatedCylinder122, OffsetSurface140, Boundary141, BoundedSurface143,
+@dataclass(frozen=True, eq=False)
+class Group402(Entity):
+    """Associativity instance, type 402, group forms 1, 7, 14, 15 (§4.?): its members."""
+
+    type_number: ClassVar[int] = 402
+    members: tuple = ()
+    group_form: int = 7
+
+    @property
+    def form(self):
+        return self.group_form
+
+    def references(self):
+        return self.members
+
+
+@dataclass(frozen=True, eq=False)
+class Conic104(Entity):
+    """Conic arc, type 104: A x^2 + B xy + C y^2 + D x + E y + F = 0 at z = ZT, from
+    (X1, Y1) to (X2, Y2) (counterclockwise for an ellipse); form 1 ellipse, 2 hyperbola,
+    3 parabola."""
+
+    type_number: ClassVar[int] = 104
+    coefficients: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    z: float = 0.0
+    start: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    end: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    conic_form: int = 0
+
+    @property
+    def form(self):
+        return self.conic_form
+
+
+FOREIGN_TYPES = (Group402, Conic104, Plane108, TabulatedCylinder122, OffsetSurface140, Boundary141, BoundedSurface143,
                  SubfigureDefinition308, SubfigureInstance408, Solid186, Shell514, Face510, Loop508,
                  EdgeList504, VertexList502)
 #: Surfaces accepted under 142, 144 and 143 when reading leniently.
@@ -433,6 +467,28 @@ def _b186(p, r, form):
     return dict(shells=tuple(shells))
 
 
+def _b402(p, r, form):
+    if form not in (1, 7, 14, 15):
+        raise IgesError(f"{p.where}: associativity form {form} carries no geometry to import")
+    n = p.count("N (number of members)", 1, lo=0)
+    members = []
+    for k in range(n):
+        j = p.pointer(f"DE({k + 1})", optional=True)
+        if j is None:
+            continue
+        try:
+            members.append(r(j, "member"))
+        except IgesError:
+            pass  # a member that cannot be read is reported as skipped on its own
+    return dict(members=tuple(members), group_form=form)
+
+
+def _b104(p, r, form):
+    c = p.reals(6, "A, B, C, D, E, F")
+    z = p.real("ZT", 0.0)
+    return dict(coefficients=c, z=z, start=p.reals(2, "X1, Y1"), end=p.reals(2, "X2, Y2"), conic_form=form)
+
+
 def _lenient_builders():
     from .reader import BUILDERS
 
@@ -443,10 +499,11 @@ def _lenient_builders():
         141: (Boundary141, _b141), 143: (BoundedSurface143, _b143), 308: (SubfigureDefinition308, _b308),
         408: (SubfigureInstance408, _b408), 502: (VertexList502, _b502), 504: (EdgeList504, _b504),
         508: (Loop508, _b508), 510: (Face510, _b510), 514: (Shell514, _b514), 186: (Solid186, _b186),
+        402: (Group402, _b402), 104: (Conic104, _b104),
     }
 
 
-LENIENT_CURVES = CURVE_TYPES
+LENIENT_CURVES = CURVE_TYPES + (Conic104,)
 
 
 def _kind(entity, value, types, what, optional=False):
@@ -499,8 +556,18 @@ def check_lenient(entity: Entity) -> None:
         _kind(entity, entity.definition, (SubfigureDefinition308,), "definition")
         if not (math.isfinite(entity.scale) and entity.scale > 0) or not np.all(np.isfinite(entity.translation)):
             raise IgesError(f"{entity.describe()}: scale {entity.scale!r} must be a finite number > 0")
-    elif isinstance(entity, (SubfigureDefinition308, VertexList502)):
+    elif isinstance(entity, (SubfigureDefinition308, VertexList502, Group402)):
         pass
+    elif isinstance(entity, Conic104):
+        conic_curve(entity)  # refuses what is not a conic arc
+    elif isinstance(entity, SurfaceOfRevolution):
+        # as written by real systems: any finite increasing angle range (OpenCASCADE takes
+        # spans past 2 pi too); the trimming loops decide what is shown
+        _kind(entity, entity.axis, (Line,), "axis")
+        _kind(entity, entity.generatrix, LENIENT_CURVES, "generatrix")
+        a, b = entity.start_angle, entity.end_angle
+        if not (math.isfinite(a) and math.isfinite(b) and a < b):
+            raise IgesError(f"{entity.describe()}: need finite start angle < end angle, got ({a!r}, {b!r})")
     elif isinstance(entity, EdgeList504):
         for c in entity.curves:
             _kind(entity, c, LENIENT_CURVES, "edge curve")
@@ -741,6 +808,15 @@ def import_root(imp, record: Entity, place, depth: int):
             imp.root(m, inner, depth + 1)
     elif isinstance(record, SubfigureDefinition308):
         return  # a definition shows only through its instances
+    elif isinstance(record, Group402):
+        if depth > MAX_SUBFIGURE_DEPTH:
+            raise IgesError(f"{record.describe()}: groups nested deeper than {MAX_SUBFIGURE_DEPTH}")
+        for m in record.members:
+            imp.root(m, place, depth + 1)
+    elif isinstance(record, Conic104):
+        from .importer import _placed_curve
+
+        imp.add_curve(record, _placed_curve(conic_curve(record), place), name)
     elif isinstance(record, BoundedSurface143):
         loops = _loops_143(imp, record)
         _mesh_face(imp, record, record.surface, loops, place, name)
@@ -780,3 +856,74 @@ def _compose(place, A, b, s, t, Ad, bd):
     M = A @ (s * Ad)
     c = A @ (s * bd + t) + b
     return place.then(M, c)
+
+
+# -- conics ---------------------------------------------------------------------------------------
+def conic_curve(record: Conic104) -> BSplineCurve:
+    """A 104 as an exact rational quadratic B-spline in 3-D (z = ZT, its 124 chain applied).
+
+    Ellipse: the affine image of a circular arc about its centre and principal axes (any
+    span up to a full turn, counterclockwise from start to end, IGES 5.3 §4.5). Parabola
+    and hyperbola: one rational Bezier segment (The NURBS Book 2e §7.2-7.3): P1 where the
+    end tangents meet, the weight from the conic's point on the line from the chord's
+    midpoint to P1."""
+    A, B, C, D, E, F = (float(x) for x in record.coefficients)
+    p0, p2 = np.asarray(record.start, float), np.asarray(record.end, float)
+    what = record.describe()
+    Q = np.array([[A, B / 2], [B / 2, C]])
+    if not np.all(np.isfinite(record.coefficients)) or not np.any(Q):
+        raise IgesError(f"{what}: not a conic (A = B = C = 0)")
+    if record.conic_form == 1 or (record.conic_form == 0 and np.linalg.det(Q) > 0):
+        try:
+            c = np.linalg.solve(Q, -0.5 * np.array([D, E]))
+        except np.linalg.LinAlgError:
+            raise IgesError(f"{what}: an ellipse with no centre") from None
+        Fc = A * c[0] ** 2 + B * c[0] * c[1] + C * c[1] ** 2 + D * c[0] + E * c[1] + F
+        lam, V = np.linalg.eigh(Q)
+        if not (np.all(lam * Fc < 0)):
+            raise IgesError(f"{what}: the coefficients are not a real ellipse")
+        axes = np.sqrt(-Fc / lam)
+        local = lambda p: (V.T @ (p - c)) / axes  # noqa: E731
+        q0, q2 = local(p0), local(p2)
+        t0 = math.atan2(q0[1], q0[0])
+        t1 = math.atan2(q2[1], q2[0])
+        if t1 <= t0 + 1e-14:
+            t1 += 2 * math.pi
+        from .convert import _arc_net
+
+        knots, cs, f, w = _arc_net(t0, t1)
+        P2 = c + ((f[:, None] * cs) * axes) @ V.T
+    else:
+        def grad(p):
+            return np.array([2 * A * p[0] + B * p[1] + D, B * p[0] + 2 * C * p[1] + E])
+
+        g0, g2 = grad(p0), grad(p2)
+        M = np.array([g0, g2])
+        if abs(np.linalg.det(M)) <= 1e-14 * (np.linalg.norm(g0) * np.linalg.norm(g2) + 1e-300):
+            raise IgesError(f"{what}: the end tangents are parallel; not one conic arc segment")
+        p1 = np.linalg.solve(M, np.array([g0 @ p0, g2 @ p2]))
+        m = 0.5 * (p0 + p2)
+        d = p1 - m
+        # conic(m + s d) = a s^2 + b s + k: the root in (0, 1)
+        def conic(p):
+            return A * p[0] ** 2 + B * p[0] * p[1] + C * p[1] ** 2 + D * p[0] + E * p[1] + F
+
+        k = conic(m)
+        a = A * d[0] ** 2 + B * d[0] * d[1] + C * d[1] ** 2
+        b = conic(m + d) - a - k
+        roots = np.roots([a, b, k]) if abs(a) > 0 else np.array([-k / b]) if b else np.array([])
+        roots = [float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) < 1e-12 and 0 < r.real < 1]
+        if not roots:
+            raise IgesError(f"{what}: the arc between its end points is not on the conic")
+        s_ = min(roots)
+        w1 = s_ / (1 - s_)  # shoulder point S = m + s (p1 - m), w = |m S| / |S p1|
+        knots, w = np.array([0, 0, 0, 1, 1, 1.0]), np.array([1.0, w1, 1.0])
+        P2 = np.array([p0, p1, p2])
+    P = np.c_[P2, np.full(len(P2), record.z)]
+    try:
+        curve = BSplineCurve(2, knots, P, w)
+    except BladesmithError as exc:
+        raise IgesError(f"{what}: {exc}") from None
+    if record.transform is None:
+        return curve
+    return curve.with_control_points(_transform(record, curve.control_points))

@@ -26,6 +26,7 @@ import math
 import os
 from collections import defaultdict
 from dataclasses import dataclass, field, replace
+from dataclasses import fields as fields_of
 
 import numpy as np
 
@@ -247,8 +248,9 @@ class _Importer:
         self.skipped = defaultdict(lambda: [0, ""])
         self.notes: list[str] = list(model.notes)
         self.base = os.path.splitext(os.path.basename(model.path or "iges"))[0]
+        prefix = f"{model.path}, " if model.path else None
         for s in model.skipped:
-            self.skip_type(s.entity_type, _short(s.reason))
+            self.skip_type(s.entity_type, _short(s.reason.replace(prefix, "") if prefix else s.reason))
 
     def skip_type(self, etype: int, why: str):
         entry = self.skipped[etype]
@@ -345,9 +347,7 @@ class _Importer:
     def model_curves(self, record: Entity) -> list[BSplineCurve]:
         if isinstance(record, CompositeCurve):
             return self.composite_leaves(record, 0)
-        if isinstance(record, Line):
-            return [_line_curve(record)]
-        return [curve_geometry(record)]
+        return [_curve_of(record)]
 
     def composite_leaves(self, record: CompositeCurve, depth: int) -> list[BSplineCurve]:
         """Constituents of a 102 as curves, nested 102s expanded, each 102's own 124 chain
@@ -359,10 +359,8 @@ class _Importer:
             self.budget.spend("curves")
             if isinstance(c, CompositeCurve):
                 out.extend(self.composite_leaves(c, depth + 1))
-            elif isinstance(c, Line):
-                out.append(_line_curve(c))
             else:
-                out.append(curve_geometry(c))
+                out.append(_curve_of(c))
         if record.transform is not None:
             A, b = _chain_matrix(record.transform)
             out = [BSplineCurve(c.degree, c.knots, _pad3(c.control_points) @ A.T + b, c.weights) for c in out]
@@ -399,6 +397,14 @@ class _Importer:
                 self.budget.spend("curves")
                 for P in self._param_points(c, depth + 1):
                     yield _transform(curve, P) if curve.transform is not None else P
+            return
+        from .foreign import Conic104, conic_curve
+
+        if isinstance(curve, Conic104):
+            c = conic_curve(curve)
+            t = np.linspace(*c.domain, 4 * LOOP_SAMPLES_PER_SPAN + 1)
+            self.budget.spend("points", len(t))
+            yield c.evaluate(t)
             return
         a, b = curve_range(curve)
         if isinstance(curve, BSplineCurve126):
@@ -453,20 +459,30 @@ class _Importer:
 def surface_as_mesh(s: BSplineSurface, name: str, tolerance: float = DISPLAY_TOLERANCE,
                     max_points: int = MIN_POINTS) -> ImportItem:
     """A mesh item of an untrimmed surface Blender cannot show as NURBS, keeping the exact
-    surface (as IGES text, metres) for export."""
-    from .convert import surface_from_geometry, surface_pieces
-    from .writer import to_string
+    surface (:func:`records_to_json`, metres) for export."""
+    from .convert import surface_from_geometry
 
     (a, b), (c, d) = s.domain_u, s.domain_v
     box = np.array([[a, c], [b, c], [b, d], [a, d]])
     mesh = tessellate(s.evaluate, [box], tolerance * s.size(), max_points)
-    exact = to_string([surface_from_geometry(q, label=name[:8]) for q in surface_pieces(s)], units="m")
+    exact = records_to_json(surface_from_geometry(s, label=name[:8]))
     return ImportItem(name, "mesh", mesh=mesh, exact=exact, trimmed=False,
                       note=f"deviation {mesh.deviation:.2g} m; exact surface kept for export")
 
 
 def _pad3(P: np.ndarray) -> np.ndarray:
     return P if P.shape[1] == 3 else np.c_[P, np.zeros((len(P), 3 - P.shape[1]))]
+
+
+def _curve_of(record: Entity) -> BSplineCurve:
+    """Any single curve record as an exact B-spline (own 124 chain applied)."""
+    from .foreign import Conic104, conic_curve
+
+    if isinstance(record, Line):
+        return _line_curve(record)
+    if isinstance(record, Conic104):
+        return conic_curve(record)
+    return curve_geometry(record)
 
 
 def _line_curve(record: Line) -> BSplineCurve:
@@ -572,30 +588,101 @@ def rigid_part(A: np.ndarray) -> tuple[np.ndarray, float]:
 
 
 def exact_text(record: Entity, place: Placement, name: str) -> tuple[str | None, str]:
-    """IGES text (metres) of ``record`` placed by ``place``, or (None, reason)."""
-    from .writer import to_string
-
+    """The exact data (:func:`records_to_json`, metres) of ``record`` placed by ``place``,
+    or (None, reason). Not validated here: the writer validates it when it is exported."""
     try:
         R, s = rigid_part(place.A)
         # x -> f (s R y + b) = R (f s y) + f b for the record's own coordinates y
         placed = place_record(record, R, place.factor * place.b, place.factor * s)
-        return to_string([replace(placed, label=name[:8])], units="m"), ""
+        return records_to_json(replace(placed, label=name[:8])), ""
     except BladesmithError as exc:
         return None, _short(str(exc))
 
 
-def exact_records(text: str) -> list:
-    """The root records of an exact-data text written by :func:`exact_text`."""
-    model = parse_iges(text)
-    return [e for e in model.roots if not isinstance(e, TransformationMatrix)]
+#: Records the exact data may hold, by class name.
+_EXACT_CLASSES = {cls.__name__: cls for cls in (
+    TransformationMatrix, Line, CircularArc, BSplineCurve126, BSplineSurface128, ParametricSpline,
+    ParametricSplineSurface, CompositeCurve, SurfaceOfRevolution, CurveOnSurface, TrimmedSurface)}
+
+
+def records_to_json(root: Entity) -> str:
+    """A record graph as JSON: one entry per record (class, fields; arrays as exact float
+    lists, references as indices of earlier entries), the root last. Floats round-trip
+    exactly (Python writes the shortest repr)."""
+    import json
+
+    index: dict = {}
+    table: list = []
+
+    def enc(value):
+        if isinstance(value, Entity):
+            return {"ref": add(value)}
+        if isinstance(value, np.ndarray):
+            return {"array": [float(x) for x in value.ravel()], "shape": list(value.shape)}
+        if isinstance(value, tuple):
+            return {"tuple": [enc(v) for v in value]}
+        if isinstance(value, np.generic):
+            return value.item()
+        if isinstance(value, (float, int, str)) or value is None:
+            return value
+        raise IgesError(f"cannot keep a {type(value).__name__} as exact data")
+
+    def add(rec):
+        if id(rec) in index:
+            return index[id(rec)]
+        if type(rec).__name__ not in _EXACT_CLASSES:
+            raise IgesError(f"{rec.describe()}: no exact export for this entity type")
+        fields = {}
+        for f in fields_of(rec):
+            if f.name == "directory" or not f.init:
+                continue
+            fields[f.name] = enc(getattr(rec, f.name))
+        index[id(rec)] = len(table)
+        table.append({"class": type(rec).__name__, "fields": fields})
+        return index[id(rec)]
+
+    add(root)
+    return json.dumps({"bladesmith_exact": 1, "records": table, "root": index[id(root)]})
+
+
+def records_from_json(text: str) -> Entity:
+    """The root record of :func:`records_to_json` output. IgesError when damaged."""
+    import json
+
+    try:
+        data = json.loads(text)
+        table = data["records"]
+        built: list = [None] * len(table)
+
+        def dec(value):
+            if isinstance(value, dict):
+                if "ref" in value:
+                    k = int(value["ref"])
+                    if not 0 <= k < len(table) or built[k] is None:
+                        raise IgesError("damaged exact data: a reference to a later record")
+                    return built[k]
+                if "array" in value:
+                    return np.array(value["array"], dtype=np.float64).reshape(value["shape"])
+                if "tuple" in value:
+                    return tuple(dec(v) for v in value["tuple"])
+                raise IgesError("damaged exact data: unknown value")
+            return value
+
+        for k, entry in enumerate(table):
+            cls = _EXACT_CLASSES[entry["class"]]
+            built[k] = cls(**{name: dec(v) for name, v in entry["fields"].items()})
+        return built[int(data["root"])]
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise IgesError(f"damaged exact data on the object: {exc}") from None
 
 
 def placed_exact_records(text: str, matrix, scale: float) -> list:
-    """Records of exact-data ``text`` moved by the 4x4 object ``matrix`` (a similarity:
-    rotation, uniform scale, translation) and scaled by ``scale`` (metres to file units)."""
+    """The exact record of ``text`` (:func:`records_to_json`) moved by the 4x4 object
+    ``matrix`` (a similarity: rotation, uniform scale, translation) and scaled by ``scale``
+    (metres to file units)."""
     M = np.asarray(matrix, dtype=np.float64)
     R, s = rigid_part(M[:3, :3])
-    return [place_record(r, R, scale * M[:3, 3], scale * s) for r in exact_records(text)]
+    return [place_record(records_from_json(text), R, scale * M[:3, 3], scale * s)]
 
 
 # -- entry points ------------------------------------------------------------------------
@@ -606,7 +693,12 @@ def import_model(model: IgesModel, file_bytes: int, tolerance: float = DISPLAY_T
     budget = Budget(file_bytes)
     imp = _Importer(model, budget, tolerance)
     place = Placement(factor=units.factor)
-    for record in model.roots:
+    roots = model.roots
+    if model.dependent and not any(_type_of(r) not in NO_GEOMETRY_TYPES for r in roots):
+        # every unreferenced entity is flagged dependent (DE status): the flags are wrong,
+        # so go by references alone, as OpenCASCADE does
+        roots = replace(model, dependent=frozenset()).roots
+    for record in roots:
         imp.root(record, place)
     counts = defaultdict(int)
     for it in imp.items:

@@ -55,6 +55,16 @@ def mutate(text: str, r: random.Random) -> str:
     return fuzz.mutate(text, r)
 
 
+def _remove_new(bpy, before):
+    """Delete what an import made, so the next case starts from the same scene."""
+    for name in set(bpy.data.objects.keys()) - before[0]:
+        bpy.data.objects.remove(bpy.data.objects[name], do_unlink=True)
+    for name in set(bpy.data.meshes.keys()) - before[1]:
+        bpy.data.meshes.remove(bpy.data.meshes[name])
+    for name in set(bpy.data.curves.keys()) - before[2]:
+        bpy.data.curves.remove(bpy.data.curves[name])
+
+
 class Hang(Exception):
     pass
 
@@ -63,7 +73,7 @@ def _alarm(signum, frame):
     raise Hang()
 
 
-def run(cases: int, seed: int, operator: bool, hang: float, tmp: pathlib.Path) -> dict:
+def run(cases: int, seed: int, operator: bool, hang: float, tmp: pathlib.Path, register: bool = True) -> dict:
     load_package()
     from bladesmith.geometry.errors import BladesmithError
     from bladesmith.iges.importer import import_model
@@ -72,7 +82,9 @@ def run(cases: int, seed: int, operator: bool, hang: float, tmp: pathlib.Path) -
     if operator:
         import bpy
 
-        sys.modules["bladesmith"].register()
+        if register:
+            sys.modules["bladesmith"].register()
+        bpy.ops.wm.read_factory_settings(use_empty=True)
     r = random.Random(seed)
     bases = base_files()
     out = {"imported": 0, "refused": 0, "hangs": 0, "foreign": 0, "scene_changed": 0}
@@ -86,12 +98,12 @@ def run(cases: int, seed: int, operator: bool, hang: float, tmp: pathlib.Path) -
             signal.setitimer(signal.ITIMER_REAL, hang)
             try:
                 if operator:
-                    bpy.ops.wm.read_factory_settings(use_empty=True)
                     path.write_bytes(data.encode("latin-1", "replace"))
                     before = set(bpy.data.objects.keys()), set(bpy.data.meshes.keys()), set(bpy.data.curves.keys())
                     try:
                         bpy.ops.import_scene.iges(filepath=str(path))
                         out["imported"] += 1
+                        _remove_new(bpy, before)
                     except RuntimeError as exc:  # the operator's CANCELLED with an error report
                         after = set(bpy.data.objects.keys()), set(bpy.data.meshes.keys()), set(bpy.data.curves.keys())
                         if after != before:
@@ -121,7 +133,7 @@ def run(cases: int, seed: int, operator: bool, hang: float, tmp: pathlib.Path) -
             if dt > slowest[0]:
                 slowest = (dt, case)
     finally:
-        if operator:
+        if operator and register:
             sys.modules["bladesmith"].unregister()
     out["slowest_s"] = round(slowest[0], 3)
     out["slowest_case"] = slowest[1]
