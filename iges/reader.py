@@ -49,10 +49,16 @@ _INT = re.compile(r"[+-]?[0-9]{1,12}")
 _DIGITS = re.compile(r"[0-9]{1,12}")
 _REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
 _HOLLERITH = re.compile(r" *([0-9]{1,9})H")
+_REALS = re.compile(r"(?:[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?,)*"
+                    r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
 
 
 class _Str(str):
     """A Hollerith string parameter (as opposed to a number or a default)."""
+
+
+class _StrTokens(list):
+    """Parameters of a record in which at least one Hollerith string was read."""
 
 
 # -- the model -----------------------------------------------------------------------------------
@@ -151,6 +157,9 @@ def _sections(lines: list[str], src: _Source, lenient: bool = False, notes: list
     ``lenient``: sequence numbers, the Terminate counts and lines after T are only noted in
     ``notes``; what makes the sections unreadable (columns, section letters, order) is
     still refused."""
+    fast = _sections_fast(lines)
+    if fast is not None:
+        return fast
     sec = {k: [] for k in SECTIONS}
     current = 0
     renumbered = 0
@@ -207,6 +216,52 @@ def _sections(lines: list[str], src: _Source, lenient: bool = False, notes: list
     return sec
 
 
+def _sections_fast(lines: list[str]):
+    """:func:`_sections` for a well-formed file, vectorised (numpy over the 80-column
+    records); None whenever anything is unusual, and the line-by-line check then says what."""
+    n = len(lines)
+    if n < 2 or set(map(len, lines)) != {80}:
+        return None
+    try:
+        flat = "".join(lines).encode("latin-1")
+    except UnicodeEncodeError:
+        return None
+    a = np.frombuffer(flat, dtype=np.uint8).reshape(n, 80)
+    order = np.full(256, -1, dtype=np.int64)
+    for k, c in enumerate(SECTIONS):
+        order[ord(c)] = k
+    code = order[a[:, 72]]
+    if np.any(code < 0) or np.any(np.diff(code) < 0):
+        return None
+    f = a[:, 73:80].astype(np.int64)
+    digit = (f >= 48) & (f <= 57)
+    space = f == 32
+    if not np.all(digit | space) or not np.all(digit[:, -1]):
+        return None
+    # spaces may only lead: once a digit is seen, no space follows
+    if np.any(space[:, 1:] & np.maximum.accumulate(digit, axis=1)[:, :-1]):
+        return None
+    value = (np.where(digit, f - 48, 0) * (10 ** np.arange(6, -1, -1))).sum(axis=1)
+    starts = np.searchsorted(code, np.arange(len(SECTIONS)))
+    expected = np.arange(n) - starts[code] + 1
+    if not np.array_equal(value, expected):
+        return None
+    counts = np.bincount(code, minlength=len(SECTIONS))
+    if counts[4] != 1 or counts[1] == 0 or counts[2] % 2:
+        return None
+    tline = lines[-1]
+    for i, c in enumerate("SGDP"):
+        field = tline[8 * i : 8 * i + 8]
+        cnt = field[1:].strip()
+        if field[0] != c or not _DIGITS.fullmatch(cnt) or int(cnt) != counts[i]:
+            return None
+    sec = {}
+    for k, c in enumerate(SECTIONS):
+        lo, hi = int(starts[k]), int(starts[k]) + int(counts[k])
+        sec[c] = list(zip(range(lo + 1, hi + 1), lines[lo:hi]))
+    return sec
+
+
 # -- parameters ----------------------------------------------------------------------------------
 def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of) -> list:
     """Parameters of one record up to its record delimiter (IGES 5.3 §2.2.3)."""
@@ -214,8 +269,11 @@ def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of) -> list:
         end = data.find(rd)
         if end < 0:
             src.error("missing record delimiter", line_of(len(data) - 1))
-        return [t.strip() for t in data[:end].split(pd)]
-    out = []
+        body = data[:end]
+        if " " not in body:
+            return body.split(pd)
+        return [t.strip() for t in body.split(pd)]
+    out = _StrTokens()
     pos, n = 0, len(data)
     # the next record delimiter is searched once and again only after a string ran past it,
     # so the scan stays linear in the record length whatever the strings contain
@@ -279,6 +337,7 @@ class _Params:
         self.src, self.where, self.line = src, where, line
         self.line_of_index = line_of_index
         self.n_entities = n_entities
+        self.has_strings = type(tokens) is _StrTokens
 
     def error(self, message: str, index: int | None = None):
         index = self.i if index is None else index
@@ -327,10 +386,16 @@ class _Params:
             self.error(f"{what}: {count} values needed, {max(self.remaining, 0)} present")
         toks = self.t[self.i : self.i + count]
         try:
-            if any(isinstance(t, _Str) or t == "" for t in toks):
+            if self.has_strings and any(isinstance(t, _Str) for t in toks):
                 raise ValueError
-            a = np.array([float(t) for t in toks], dtype=np.float64)
-            if not np.all(np.isfinite(a)) or not all(_REAL.fullmatch(t) for t in toks):
+            # one regex pass over the joined tokens instead of one per token
+            joined = ",".join(toks)
+            if count and not _REALS.fullmatch(joined):
+                raise ValueError
+            if "D" in joined or "d" in joined:
+                joined = joined.replace("D", "E").replace("d", "e")
+            a = np.array(joined.split(",") if count else [], dtype=np.float64)
+            if not np.all(np.isfinite(a)):
                 raise ValueError
         except ValueError:
             a = np.empty(count)
@@ -683,11 +748,13 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
         first_line = plines[ptr - 1][0]
         chunks = []
         seq = 2 * i + 1
+        expected = f"{seq:7d}"
         for k in range(ptr - 1, ptr - 1 + count):
             ln, text = plines[k]
-            back = text[65:72].strip()
-            if not _DIGITS.fullmatch(back) or int(back) != seq:
-                src.error(f"parameter line points back to DE {text[65:72].strip()!r}; expected {seq}", ln)
+            if text[65:72] != expected:  # the usual right-justified form, else check properly
+                back = text[65:72].strip()
+                if not _DIGITS.fullmatch(back) or int(back) != seq:
+                    src.error(f"parameter line points back to DE {text[65:72].strip()!r}; expected {seq}", ln)
             chunks.append(text[:64])
         data = "".join(chunks)
 
