@@ -22,9 +22,13 @@ from scipy.spatial import Delaunay, QhullError, cKDTree
 from ..geometry.errors import IgesError
 
 #: Refinement rounds (each adds the failing probe points as vertices) before giving up.
-MAX_ROUNDS = 12
+MAX_ROUNDS = 8
 #: First grid: this many cells across the larger side of the loop's bounding box.
 START_CELLS = 16
+#: Refinement adds no vertex nearer than this fraction of the face's larger side to another.
+MIN_SPACING = 1e-4
+#: Triangles of less (doubled) area than this fraction of the face's larger side squared are dropped.
+SLIVER_AREA = 1e-12
 #: Most vertices of one face's display mesh (a tolerance missed at this size is reported).
 MAX_FACE_POINTS = 20_000
 #: Edges processed at once by the point-in-polygon test (bounds the memory to
@@ -138,6 +142,7 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
     if len(P) > max_points:
         raise IgesError(f"meshing the trimmed face needs more than the budget of {max_points} points")
     X = evaluate(*(P / scale + lo).T)
+    floor = MIN_SPACING * h * START_CELLS
     weights = (np.array([1, 1, 1]) / 3, np.array([0.5, 0.5, 0]), np.array([0, 0.5, 0.5]), np.array([0.5, 0, 0.5]))
     for _ in range(MAX_ROUNDS):
         try:
@@ -145,6 +150,10 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
         except QhullError:  # degenerate: all loop points on a line
             raise IgesError("the trimming loops are degenerate (all points on a line)") from None
         tri = tri[inside(P[tri].mean(axis=1), mloops)]
+        # Qhull leaves slivers of (almost) zero area along straight runs of loop points:
+        # they show nothing and their chords are not part of the surface
+        e1, e2 = P[tri[:, 1]] - P[tri[:, 0]], P[tri[:, 2]] - P[tri[:, 0]]
+        tri = tri[np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) > SLIVER_AREA * float(width.max()) ** 2]
         if not len(tri):
             raise IgesError("the trimming loops bound no area")
         if not np.all(np.isfinite(X)):
@@ -154,17 +163,26 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
         linear = np.concatenate([np.einsum("k,mkd->md", w, X[tri]) for w in weights])
         Xp = evaluate(*(probes / scale + lo).T)
         dev = np.linalg.norm(Xp - linear, axis=1)
+        # probes outside the region (edges of triangles over a concave part of a loop)
+        # evaluate the surface where the face is not: they do not count
+        dev[~inside(probes, mloops)] = 0.0
         deviation = float(dev.max()) if dev.size else 0.0
         best = TrimmedMesh(X, tri.astype(np.int64), P / scale + lo, deviation)
         bad = dev > tolerance
         if not bad.any():
             break
-        # refine where the mesh misses: the failing probes become vertices
-        new, k = np.unique(probes[bad], axis=0, return_index=True)
-        if len(P) + len(new) > max_points:
+        # refine where the mesh misses: the failing probe points become vertices, but not
+        # nearer than ``floor`` to a vertex (nearly coincident points stall Qhull, and a
+        # miss that survives at that spacing is a singular spot, reported by ``deviation``)
+        cand, cx = probes[bad], Xp[bad]
+        keep = cKDTree(P).query(cand)[0] > floor
+        cand, cx = cand[keep], cx[keep]
+        _, k = np.unique(np.round(cand / floor), axis=0, return_index=True)
+        cand, cx = cand[k], cx[k]
+        if not len(cand) or len(P) + len(cand) > max_points:
             break
-        P = np.concatenate([P, new])
-        X = np.concatenate([X, Xp[bad][k]])
+        P = np.concatenate([P, cand])
+        X = np.concatenate([X, cx])
     if best is None:
         raise IgesError(f"meshing the trimmed face within budget of {max_points} points is not possible")
     return best
