@@ -158,9 +158,10 @@ def occ_summary(path):
     from OCP.TopAbs import TopAbs_FACE
     from OCP.TopExp import TopExp_Explorer
 
-    Interface_Static.SetCVal_s("xstep.cascade.unit", "M")
     t = time.perf_counter()
-    reader = IGESControl_Reader()
+    reader = IGESControl_Reader()  # first: it creates the static parameters set below
+    if not Interface_Static.SetCVal_s("xstep.cascade.unit", "M"):
+        raise RuntimeError("cannot set OpenCASCADE's output unit to metres")
     if reader.ReadFile(str(path)) != IFSelect_RetDone:
         return None, None, time.perf_counter() - t
     reader.TransferRoots()

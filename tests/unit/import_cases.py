@@ -150,17 +150,18 @@ def matrix_params(R, T) -> list:
     return [repr(float(x)) for x in M.ravel()]
 
 
-def subfigure_instance() -> tuple[str, np.ndarray]:
-    """A 408 of a 308 holding one line, scale 2, translation (1, 2, 3), and a 124 on the 408:
-    returns (text, expected end points (2, 3))."""
+def subfigure_instance(scale: float = 2.0) -> tuple[str, np.ndarray]:
+    """A 408 of a 308 holding one line, scale ``scale``, translation (1, 2, 3), and a 124 on
+    the 408: returns (text, expected end points (2, 3)) by IGES 5.3 §4.137 (definition
+    scaled by S, then translated, then the 408's own matrix)."""
     p0, p1 = np.array([1.0, 0.0, 0.0]), np.array([1.0, 1.0, 0.5])
     ents = [
         (110, [*p0, *p1], 0, 0, "01"),               # 1: the member
         (308, [0, "4Hpart", 1, "@1"], 0, 0, "02"),    # 2: the definition
         (124, matrix_params(R1, T1), 0, 0, "01"),    # 3: the instance's transform
-        (408, ["@2", 1.0, 2.0, 3.0, 2.0], 0, 3, "00"),  # 4: the instance
+        (408, ["@2", 1.0, 2.0, 3.0, scale], 0, 3, "00"),  # 4: the instance
     ]
-    expected = (2.0 * np.stack([p0, p1]) + [1.0, 2.0, 3.0]) @ R1.T + T1
+    expected = (scale * np.stack([p0, p1]) + [1.0, 2.0, 3.0]) @ R1.T + T1
     return raw_file(ents), expected
 
 
