@@ -15,13 +15,14 @@ reference blade as 128 and the hub sector trimmed by the blade footprint as a 14
 120, in the propeller's own coordinates. Rotated copies of a blade are rotated copies of
 these surfaces, which a mesher makes itself.
 
-Import creates exact NURBS objects for 126/128 (and 100, 110, 112, 114, 120 converted to
-B-splines); a trimmed surface (144) comes in as its untrimmed surface plus its trimming
-curves, and the report says so. A failure leaves the scene as it was.
+Import (:func:`import_file`) reads leniently through :mod:`..iges.importer`: exact NURBS
+objects at the file's units and placement, trimmed faces as meshes inside their loops
+that keep the exact 144 as ``bladesmith_iges_exact`` (export writes it back exactly, moved
+with the object), and a report of every entity type skipped and why. A refusal leaves
+the scene as it was.
 """
 from __future__ import annotations
 
-import os
 
 import bpy
 import numpy as np
