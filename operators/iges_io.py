@@ -23,7 +23,6 @@ the scene as it was.
 """
 from __future__ import annotations
 
-
 import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, StringProperty
