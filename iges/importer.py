@@ -93,7 +93,7 @@ ARC_SAMPLES_PER_RADIAN = 24
 #: Blender shows NURBS of degree <= 5 (order 6); higher degrees are meshed for display.
 MAX_DISPLAY_DEGREE = 5
 #: Entity types that carry no geometry to show (annotation, properties, views ...).
-NO_GEOMETRY_TYPES = {0, 124, 202, 206, 210, 212, 214, 216, 218, 220, 222, 228, 230, 302, 304, 306,
+NO_GEOMETRY_TYPES = {0, 123, 124, 502, 202, 206, 210, 212, 214, 216, 218, 220, 222, 228, 230, 302, 304, 306,
                      310, 312, 314, 316, 320, 322, 402, 404, 406, 410, 412, 414, 416, 418, 420, 422,
                      430}
 

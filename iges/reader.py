@@ -644,8 +644,8 @@ def _raw_pointers(etype: int, tokens, n_entities: int) -> list[int]:
     """Best-effort DE indices a skipped entity of a known referring type points to, so that
     its children are not taken for independent entities."""
     positions = {102: None, 142: (2, 3, 4), 144: None, 120: (1, 2), 122: (1,), 141: None, 143: None,
-                 140: (2,), 308: None, 408: (1,), 186: (1,), 510: (1,), 508: None, 514: None, 502: None,
-                 504: None}
+                 140: (2,), 308: None, 408: (1,), 186: None, 510: None, 508: None, 514: None, 502: None,
+                 504: None, 402: None, 190: None, 192: None, 194: None, 196: None, 198: None}
     if etype not in positions:
         return []
     idx = positions[etype] or range(1, len(tokens))
@@ -823,7 +823,9 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
     # children of skipped entities, and entities the file marks as dependent (DE status
     # digits 3-4 non-zero, IGES 5.3 §2.2.4.4.9), are not independent roots
     dependent = set()
+    # (and of entities read only generically, such as 190-198 surfaces under a skipped face)
     below_skipped = {j for i in skipped for j in raw_refs.get(i, ())}
+    below_skipped |= {j for i, e in enumerate(built) if isinstance(e, GenericEntity) for j in raw_refs.get(i, ())}
     for i, e in enumerate(built):
         if e is None:
             continue

@@ -29,6 +29,8 @@ START_CELLS = 16
 MIN_SPACING = 1e-4
 #: Triangles of less (doubled) area than this fraction of the face's larger side squared are dropped.
 SLIVER_AREA = 1e-12
+#: Least stretch of one parameter direction relative to the other.
+MIN_STRETCH = 1e-3
 #: Most vertices of one face's display mesh (a tolerance missed at this size is reported).
 MAX_FACE_POINTS = 20_000
 #: Edges processed at once by the point-in-polygon test (bounds the memory to
@@ -121,6 +123,9 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
     su = float(np.mean(np.linalg.norm(np.diff(X, axis=0), axis=-1))) / (span[0] / 8) + 1e-300
     sv = float(np.mean(np.linalg.norm(np.diff(X, axis=1), axis=-1))) / (span[1] / 8) + 1e-300
     scale = np.array([su, sv])
+    # a direction in which the surface hardly moves (a pole, a degenerate patch) still gets
+    # points: its stretch is floored at a fraction of the other's
+    scale = np.maximum(scale, MIN_STRETCH * scale.max())
     if not np.all(np.isfinite(scale)):
         raise IgesError("the surface is not finite over its trimming loops")
     mloops = [(l - lo) * scale for l in loops_uv]

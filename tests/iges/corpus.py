@@ -193,7 +193,7 @@ def _item_points(item) -> np.ndarray:
     return g.evaluate(U, V).reshape(-1, 3)
 
 
-def compare(files) -> list[Row]:
+def compare(files, progress=None) -> list[Row]:
     from bladesmith.geometry.errors import BladesmithError
     from bladesmith.iges.importer import import_path
 
@@ -205,6 +205,8 @@ def compare(files) -> list[Row]:
             report = import_path(f.path)
         except BladesmithError as exc:
             rows.append(Row(f.name, occ_n, None, 0, None, time.perf_counter() - t, occ_t, str(exc)[-160:]))
+            if progress:
+                progress(rows[-1])
             continue
         dt = time.perf_counter() - t
         faces = report.counts.get("surface", 0) + report.counts.get("mesh", 0)
@@ -216,6 +218,8 @@ def compare(files) -> list[Row]:
             err = float(np.abs(box - occ_box).max()) / diag
         rows.append(Row(f.name, occ_n, faces, report.counts.get("curve", 0), err, dt, occ_t,
                         report.skipped_summary()[:160]))
+        if progress:
+            progress(rows[-1])
     return rows
 
 
@@ -238,4 +242,6 @@ if __name__ == "__main__":
     sys.path.insert(0, str(HERE.parent))
     import conftest  # noqa: F401  (loads the checkout as ``bladesmith``)
 
-    print(table(compare(corpus())))
+    only = sys.argv[1:]
+    files = [f for f in corpus() if not only or f.name in only]
+    print(table(compare(files, progress=lambda r: print(table([r]).splitlines()[1], flush=True))))
