@@ -187,7 +187,7 @@ def _item_points(item) -> np.ndarray:
     if item.kind == "mesh":
         return item.mesh.vertices
     if item.kind == "curve":
-        return g.evaluate(np.linspace(*g.domain, 513))
+        return g.evaluate(np.linspace(*g.domain, 8193))  # extremes to ~1e-8 of the size
     (a, b), (c, d) = g.domain_u, g.domain_v
     U, V = np.meshgrid(np.linspace(a, b, 65), np.linspace(c, d, 65), indexing="ij")
     return g.evaluate(U, V).reshape(-1, 3)
