@@ -174,6 +174,8 @@ def test_trimmed_face_round_trip_through_opencascade(scene, tmp_path, case):
     assert second.load_messages == [] and second.transfer_messages == []
     a1 = sum(occ.face_area(f) for f in first.faces)
     a2 = sum(occ.face_area(f) for f in second.faces)
+    print(f"{case}: OCC area {a1!r} before, {a2!r} after import -> export ({abs(a2 / a1 - 1.0):.1e}); "
+          f"messages {second.load_messages + second.transfer_messages}")
     assert len(first.faces) == len(second.faces)
     assert abs(a2 / a1 - 1.0) < 1e-9, (a1, a2)
 
