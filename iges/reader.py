@@ -394,8 +394,9 @@ class _Params:
                 raise ValueError
             if "D" in joined or "d" in joined:
                 joined = joined.replace("D", "E").replace("d", "e")
-            a = np.array(joined.split(",") if count else [], dtype=np.float64)
-            if not np.all(np.isfinite(a)):
+            # the text was checked by _REALS: numpy's C text parser reads it at once
+            a = np.fromstring(joined, dtype=np.float64, sep=",") if count else np.empty(0)
+            if a.size != count or not np.all(np.isfinite(a)):
                 raise ValueError
         except ValueError:
             a = np.empty(count)
