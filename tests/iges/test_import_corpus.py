@@ -13,7 +13,7 @@ import sys
 import pytest
 
 HERE = pathlib.Path(__file__).resolve().parent
-SUITE_BYTES = 80_000
+SUITE_BYTES = 45_000
 #: Bounding boxes of the trimmed faces' meshes agree with OCC's exact ones to this fraction of
 #: the model's diagonal (the meshes are within 1e-3 of each face's size).
 BBOX_TOL = 2e-3
