@@ -1,12 +1,13 @@
 """Entities other CAD systems write that Bladesmith does not write, read for import only:
 
-* 108 plane (IGES 5.3 §4.12), 122 tabulated cylinder (§4.16), 140 offset surface (§4.29)
-  as bases of 142/144;
-* 141 boundary and 143 bounded surface (§4.20-4.21 of the 5.3 numbering: boundary
-  entities over a surface, model-space curves with optional parameter-space curves);
-* 308 subfigure definition and 408 singular subfigure instance (§4.74, §4.137);
-* 186 manifold solid B-rep with its 502/504/508/510/514 topology (§4.? of the B-rep
-  appendix): each face is imported as a trimmed face.
+* 108 plane, 122 tabulated cylinder, 140 offset surface (IGES 5.3 entity types) as
+  bases of 142/144;
+* 141 boundary and 143 bounded surface (model-space curves with optional
+  parameter-space curves over a surface);
+* 308 subfigure definition and 408 singular subfigure instance;
+* 402 groups (forms 1, 7, 14, 15) and 104 conic arcs;
+* 186 manifold solid B-rep with its 502/504/508/510/514 topology: each face is imported
+  as a trimmed face. Faces on the analytic surfaces 190-198 are not read yet.
 
 Also the lenient builders the reader uses with ``strict=False`` (:data:`LENIENT_BUILDERS`)
 and their structure checks (:func:`check_lenient`), which accept these surfaces under
@@ -216,7 +217,7 @@ class Solid186(Entity):
 
 @dataclass(frozen=True, eq=False)
 class Group402(Entity):
-    """Associativity instance, type 402, group forms 1, 7, 14, 15 (§4.?): its members."""
+    """Associativity instance, type 402, group forms 1, 7, 14, 15: its members."""
 
     type_number: ClassVar[int] = 402
     members: tuple = ()
@@ -801,7 +802,7 @@ def import_root(imp, record: Entity, place, depth: int):
         A, b = _chain_matrix_of(record)
         defn = record.definition
         Ad, bd = _chain_matrix_of(defn)
-        # IGES 5.3 §4.137: members scaled by S about the origin, moved by (X, Y, Z), then
+        # IGES 5.3, type 408: members scaled by S about the origin, moved by (X, Y, Z), then
         # the 408's own 124
         inner = _compose(place, A, b, record.scale, record.translation, Ad, bd)
         for m in defn.members:
@@ -863,7 +864,7 @@ def conic_curve(record: Conic104) -> BSplineCurve:
     """A 104 as an exact rational quadratic B-spline in 3-D (z = ZT, its 124 chain applied).
 
     Ellipse: the affine image of a circular arc about its centre and principal axes (any
-    span up to a full turn, counterclockwise from start to end, IGES 5.3 §4.5). Parabola
+    span up to a full turn, counterclockwise from start to end). Parabola
     and hyperbola: one rational Bezier segment (The NURBS Book 2e §7.2-7.3): P1 where the
     end tangents meet, the weight from the conic's point on the line from the chord's
     midpoint to P1."""

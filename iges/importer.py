@@ -9,7 +9,7 @@ bpy-free; the import operator only turns :class:`ImportItem` objects into Blende
   and an unknown unit are refused.
 * Placement: every entity's own 124 chain (curves, surfaces, 102 and its constituents,
   142/144 and the surface under them), then the placement of the 408 singular subfigure
-  instances that bring it in (§4.74, §4.137: scale S, then translation, then the 408's own
+  instances that bring it in (308/408: scale S, then translation, then the 408's own
   124), then the unit factor.
 * Resilience: an entity that cannot be converted is skipped with its reason; the report
   counts every skipped type. Only a file with nothing importable, units that cannot be

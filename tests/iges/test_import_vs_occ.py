@@ -56,7 +56,7 @@ def test_placement_matches_opencascade(tmp_path, case):
     text = {
         "composite": lambda: C.composite_with_transform()[0],
         "nested composites": lambda: C.nested_composites(3)[0],
-        # scale 1: OpenCASCADE 7.x places a scaled 408 differently from IGES 5.3 §4.137
+        # scale 1: OpenCASCADE 7.x places a scaled 408 differently from IGES 5.3 (type 408)
         # (which the unit test checks); translation and the 408's matrix agree
         "subfigure instance": lambda: C.subfigure_instance(1.0)[0],
         "trimmed with transforms": lambda: C.trimmed_with_transforms()[0],

@@ -152,7 +152,7 @@ def matrix_params(R, T) -> list:
 
 def subfigure_instance(scale: float = 2.0) -> tuple[str, np.ndarray]:
     """A 408 of a 308 holding one line, scale ``scale``, translation (1, 2, 3), and a 124 on
-    the 408: returns (text, expected end points (2, 3)) by IGES 5.3 §4.137 (definition
+    the 408: returns (text, expected end points (2, 3)) by IGES 5.3 type 408 (definition
     scaled by S, then translated, then the 408's own matrix)."""
     p0, p1 = np.array([1.0, 0.0, 0.0]), np.array([1.0, 1.0, 0.5])
     ents = [
