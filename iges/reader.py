@@ -49,10 +49,16 @@ _INT = re.compile(r"[+-]?[0-9]{1,12}")
 _DIGITS = re.compile(r"[0-9]{1,12}")
 _REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
 _HOLLERITH = re.compile(r" *([0-9]{1,9})H")
+_REALS = re.compile(r"(?:[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?,)*"
+                    r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
 
 
 class _Str(str):
     """A Hollerith string parameter (as opposed to a number or a default)."""
+
+
+class _StrTokens(list):
+    """Parameters of a record in which at least one Hollerith string was read."""
 
 
 # -- the model -----------------------------------------------------------------------------------
@@ -64,11 +70,19 @@ class IgesModel:
     header: GlobalSection
     start: str = ""
     path: str | None = None
+    #: lenient reading only: entities skipped, with reasons (:class:`SkippedEntity`)
+    skipped: tuple = ()
+    #: lenient reading only: what was tolerated (blank lines, wrong counts ...)
+    notes: tuple = ()
+    #: Global fields that were defaulted (empty) in the file
+    defaulted: frozenset = frozenset()
+    #: ids of entities that are not independent although nothing read refers to them
+    dependent: frozenset = frozenset()
 
     @property
     def roots(self) -> tuple:
         """Entities no other entity references (the independent ones)."""
-        referenced = set()
+        referenced = set(self.dependent)
         for e in self.entities:
             for c in e.references():
                 referenced.add(id(c))
@@ -105,7 +119,7 @@ class _Source:
         raise IgesError(message, path=self.path, line=line)
 
 
-def _split_lines(data) -> list[str]:
+def _split_lines(data, lenient: bool = False, notes: list | None = None) -> list[str]:
     if isinstance(data, (bytes, bytearray)):
         text = bytes(data).decode("latin-1")
     else:
@@ -114,13 +128,41 @@ def _split_lines(data) -> list[str]:
     lines = text.split("\n")
     if lines and lines[-1] == "":
         lines.pop()
-    return lines
+    if not lenient:
+        return lines
+    # What CAD systems really write: no newlines at all (80-column records run together),
+    # trailing blanks stripped, blank lines (often after the T section), padding past 80.
+    if len(lines) == 1 and len(lines[0]) > 80:
+        flat = lines[0]
+        lines = [flat[k : k + 80] for k in range(0, len(flat), 80)]
+        notes.append("the file has no line breaks; read as 80-column records")
+    out, blank = [], 0
+    for line in lines:
+        if not line.strip():
+            blank += 1
+            continue
+        if len(line) > 80 and not line[80:].strip():
+            line = line[:80]
+        elif 73 <= len(line) < 80:
+            line = line.ljust(80)
+        out.append(line)
+    if blank:
+        notes.append(f"{blank} blank line(s) ignored")
+    return out
 
 
-def _sections(lines: list[str], src: _Source) -> dict:
-    """Lines per section as (line number, text), checking columns, order and sequence numbers."""
+def _sections(lines: list[str], src: _Source, lenient: bool = False, notes: list | None = None) -> dict:
+    """Lines per section as (line number, text), checking columns, order and sequence numbers.
+
+    ``lenient``: sequence numbers, the Terminate counts and lines after T are only noted in
+    ``notes``; what makes the sections unreadable (columns, section letters, order) is
+    still refused."""
+    fast = _sections_fast(lines)
+    if fast is not None:
+        return fast
     sec = {k: [] for k in SECTIONS}
     current = 0
+    renumbered = 0
     for n, line in enumerate(lines, 1):
         if len(line) != 80:
             if len(line) >= 73 and line[72] in "CB" and n == 1:
@@ -132,29 +174,91 @@ def _sections(lines: list[str], src: _Source) -> dict:
         if k < 0:
             src.error(f"column 73 must be one of S, G, D, P, T; got {code!r}", n)
         if k < current:
+            if lenient and current == 4:
+                notes.append(f"line {n}: text after the Terminate section ignored")
+                break
             src.error(f"section {code} after section {SECTIONS[current]}", n)
         current = k
         seq_text = line[73:80].strip()
         if not _DIGITS.fullmatch(seq_text) or int(seq_text) != len(sec[code]) + 1:
-            src.error(f"sequence number {line[73:80]!r} in columns 74-80; expected {len(sec[code]) + 1}", n)
+            if not lenient:
+                src.error(f"sequence number {line[73:80]!r} in columns 74-80; expected {len(sec[code]) + 1}", n)
+            renumbered += 1  # pointers count lines by position, so the position rules
         sec[code].append((n, line))
     if not lines:
         src.error("the file is empty", None)
     if not sec["G"]:
         src.error("the Global section is missing", len(lines))
-    if len(sec["T"]) != 1:
-        src.error("missing or repeated Terminate section (file truncated?)", len(lines))
-    tn, tline = sec["T"][0]
-    if tn != len(lines):
-        src.error("lines after the Terminate section", tn + 1)
-    for i, code in enumerate("SGDP"):
-        field = tline[8 * i : 8 * i + 8]
-        count = field[1:].strip()
-        if field[0] != code or not _DIGITS.fullmatch(count) or int(count) != len(sec[code]):
-            src.error(f"Terminate section: expected {code}{len(sec[code]):7d} in columns "
-                      f"{8 * i + 1}-{8 * i + 8}, got {field!r}", tn)
+    if renumbered:
+        notes.append(f"{renumbered} wrong sequence number(s) ignored (lines are counted by position)")
+    if lenient and len(sec["T"]) != 1:
+        notes.append("missing or repeated Terminate section (file truncated?)")
+    else:
+        if len(sec["T"]) != 1:
+            src.error("missing or repeated Terminate section (file truncated?)", len(lines))
+        tn, tline = sec["T"][0]
+        if tn != len(lines) and not lenient:
+            src.error("lines after the Terminate section", tn + 1)
+        for i, code in enumerate("SGDP"):
+            field = tline[8 * i : 8 * i + 8]
+            count = field[1:].strip()
+            if field[0] != code or not _DIGITS.fullmatch(count) or int(count) != len(sec[code]):
+                if lenient:
+                    notes.append(f"Terminate section: {field!r} does not count {len(sec[code])} {code} lines")
+                    continue
+                src.error(f"Terminate section: expected {code}{len(sec[code]):7d} in columns "
+                          f"{8 * i + 1}-{8 * i + 8}, got {field!r}", tn)
     if len(sec["D"]) % 2:
-        src.error("the Directory Entry section has an odd number of lines", sec["D"][-1][0])
+        if not lenient:
+            src.error("the Directory Entry section has an odd number of lines", sec["D"][-1][0])
+        notes.append(f"line {sec['D'][-1][0]}: unpaired last Directory Entry line ignored")
+        sec["D"].pop()
+    return sec
+
+
+def _sections_fast(lines: list[str]):
+    """:func:`_sections` for a well-formed file, vectorised (numpy over the 80-column
+    records); None whenever anything is unusual, and the line-by-line check then says what."""
+    n = len(lines)
+    if n < 2 or set(map(len, lines)) != {80}:
+        return None
+    try:
+        flat = "".join(lines).encode("latin-1")
+    except UnicodeEncodeError:
+        return None
+    a = np.frombuffer(flat, dtype=np.uint8).reshape(n, 80)
+    order = np.full(256, -1, dtype=np.int64)
+    for k, c in enumerate(SECTIONS):
+        order[ord(c)] = k
+    code = order[a[:, 72]]
+    if np.any(code < 0) or np.any(np.diff(code) < 0):
+        return None
+    f = a[:, 73:80].astype(np.int64)
+    digit = (f >= 48) & (f <= 57)
+    space = f == 32
+    if not np.all(digit | space) or not np.all(digit[:, -1]):
+        return None
+    # spaces may only lead: once a digit is seen, no space follows
+    if np.any(space[:, 1:] & np.maximum.accumulate(digit, axis=1)[:, :-1]):
+        return None
+    value = (np.where(digit, f - 48, 0) * (10 ** np.arange(6, -1, -1))).sum(axis=1)
+    starts = np.searchsorted(code, np.arange(len(SECTIONS)))
+    expected = np.arange(n) - starts[code] + 1
+    if not np.array_equal(value, expected):
+        return None
+    counts = np.bincount(code, minlength=len(SECTIONS))
+    if counts[4] != 1 or counts[1] == 0 or counts[2] % 2:
+        return None
+    tline = lines[-1]
+    for i, c in enumerate("SGDP"):
+        field = tline[8 * i : 8 * i + 8]
+        cnt = field[1:].strip()
+        if field[0] != c or not _DIGITS.fullmatch(cnt) or int(cnt) != counts[i]:
+            return None
+    sec = {}
+    for k, c in enumerate(SECTIONS):
+        lo, hi = int(starts[k]), int(starts[k]) + int(counts[k])
+        sec[c] = list(zip(range(lo + 1, hi + 1), lines[lo:hi]))
     return sec
 
 
@@ -165,9 +269,15 @@ def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of) -> list:
         end = data.find(rd)
         if end < 0:
             src.error("missing record delimiter", line_of(len(data) - 1))
-        return [t.strip() for t in data[:end].split(pd)]
-    out = []
+        body = data[:end]
+        if " " not in body:
+            return body.split(pd)
+        return [t.strip() for t in body.split(pd)]
+    out = _StrTokens()
     pos, n = 0, len(data)
+    # the next record delimiter is searched once and again only after a string ran past it,
+    # so the scan stays linear in the record length whatever the strings contain
+    b = data.find(rd)
     while True:
         m = _HOLLERITH.match(data, pos)
         if m:
@@ -188,8 +298,9 @@ def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of) -> list:
             if c == rd:
                 return out
             src.error(f"expected a delimiter after a string, got {c!r}", line_of(pos))
-        a = data.find(pd, pos)
-        b = data.find(rd, pos)
+        if 0 <= b < pos:
+            b = data.find(rd, pos)
+        a = data.find(pd, pos, b if b >= 0 else n)
         if b < 0:
             src.error("missing record delimiter", line_of(n - 1))
         if 0 <= a < b:
@@ -226,6 +337,7 @@ class _Params:
         self.src, self.where, self.line = src, where, line
         self.line_of_index = line_of_index
         self.n_entities = n_entities
+        self.has_strings = type(tokens) is _StrTokens
 
     def error(self, message: str, index: int | None = None):
         index = self.i if index is None else index
@@ -274,10 +386,17 @@ class _Params:
             self.error(f"{what}: {count} values needed, {max(self.remaining, 0)} present")
         toks = self.t[self.i : self.i + count]
         try:
-            if any(isinstance(t, _Str) or t == "" for t in toks):
+            if self.has_strings and any(isinstance(t, _Str) for t in toks):
                 raise ValueError
-            a = np.array([float(t) for t in toks], dtype=np.float64)
-            if not np.all(np.isfinite(a)) or not all(_REAL.fullmatch(t) for t in toks):
+            # one regex pass over the joined tokens instead of one per token
+            joined = ",".join(toks)
+            if count and not _REALS.fullmatch(joined):
+                raise ValueError
+            if "D" in joined or "d" in joined:
+                joined = joined.replace("D", "E").replace("d", "e")
+            # the text was checked by _REALS: numpy's C text parser reads it at once
+            a = np.fromstring(joined, dtype=np.float64, sep=",") if count else np.empty(0)
+            if a.size != count or not np.all(np.isfinite(a)):
                 raise ValueError
         except ValueError:
             a = np.empty(count)
@@ -445,7 +564,7 @@ def _field_int(text: str, src: _Source, line: int, what: str) -> int:
     return int(s)
 
 
-def _parse_global(glines, src: _Source) -> tuple[GlobalSection, str, str]:
+def _parse_global(glines, src: _Source, notes: list | None = None) -> tuple:
     data = "".join(line[:72] for _, line in glines)
     first = glines[0][0]
 
@@ -478,83 +597,165 @@ def _parse_global(glines, src: _Source) -> tuple[GlobalSection, str, str]:
         src.error(f"Global section: unusable delimiters {pd!r} and {rd!r}", first)
     tokens = [] if ended else _tokenize(data[pos:], pd, rd, src, lambda o: line_of(o + pos))
     values = {"parameter_delimiter": pd, "record_delimiter": rd}
+    defaulted = set()
     for k, (name, kind) in enumerate(GLOBAL_FIELDS[2:]):
         tok = tokens[k] if k < len(tokens) else ""
         where = f"Global section field {k + 3} ({name})"
         if tok == "":
-            continue  # defaulted
-        if kind == "s":
-            if not isinstance(tok, _Str):
-                src.error(f"{where}: expected a string, got {tok[:40]!r}", line_of(pos))
-            values[name] = str(tok)
-        elif kind == "i":
-            v = _parse_int(tok)
-            if v is None:
-                src.error(f"{where}: expected an integer, got {str(tok)[:40]!r}", line_of(pos))
-            values[name] = v
-        else:
-            v = _parse_real(tok)
-            if v is None:
-                src.error(f"{where}: expected a finite real, got {str(tok)[:40]!r}", line_of(pos))
-            values[name] = v
-    return GlobalSection(**values), pd, rd
+            defaulted.add(name)
+            continue
+        try:
+            if kind == "s":
+                if not isinstance(tok, _Str):
+                    src.error(f"{where}: expected a string, got {tok[:40]!r}", line_of(pos))
+                values[name] = str(tok)
+            elif kind == "i":
+                v = _parse_int(tok)
+                if v is None:
+                    src.error(f"{where}: expected an integer, got {str(tok)[:40]!r}", line_of(pos))
+                values[name] = v
+            else:
+                v = _parse_real(tok)
+                if v is None:
+                    src.error(f"{where}: expected a finite real, got {str(tok)[:40]!r}", line_of(pos))
+                values[name] = v
+        except IgesError as exc:
+            # a field that does not decide size or place is noted, not fatal, when lenient
+            if notes is None or name in ("model_scale", "unit_flag", "unit_name"):
+                raise
+            notes.append(f"{exc}; field ignored")
+            defaulted.add(name)
+    return GlobalSection(**values), pd, rd, frozenset(defaulted)
 
 
-def parse_iges(data, path=None) -> IgesModel:
-    """Parse IGES text (str or bytes) into an :class:`IgesModel`; IgesError on malformed input."""
+@dataclass(frozen=True)
+class SkippedEntity:
+    """An entity the lenient reader could not take (``parse_iges(..., strict=False)``).
+
+    sequence: its DE sequence number; line: its first DE line; reason: why."""
+
+    sequence: int
+    entity_type: int
+    form: int
+    reason: str
+    line: int | None = None
+
+
+def _raw_pointers(etype: int, tokens, n_entities: int) -> list[int]:
+    """Best-effort DE indices a skipped entity of a known referring type points to, so that
+    its children are not taken for independent entities."""
+    positions = {102: None, 142: (2, 3, 4), 144: None, 120: (1, 2), 122: (1,), 141: None, 143: None,
+                 140: (2,), 308: None, 408: (1,), 186: None, 510: None, 508: None, 514: None, 502: None,
+                 504: None, 402: None, 190: None, 192: None, 194: None, 196: None, 198: None}
+    if etype not in positions:
+        return []
+    idx = positions[etype] or range(1, len(tokens))
+    out = []
+    for k in idx:
+        if k < len(tokens):
+            v = _parse_int(tokens[k])
+            if v is not None and v > 0 and v % 2 == 1 and v <= 2 * n_entities - 1:
+                out.append((v - 1) // 2)
+    return out
+
+
+def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
+    """Parse IGES text (str or bytes) into an :class:`IgesModel`; IgesError on malformed input.
+
+    ``strict=False`` reads what CAD systems really write: blank lines, missing newlines,
+    wrong S/G sequence numbers and Terminate counts are noted in ``model.notes``; an entity
+    that cannot be read (or refers to one that cannot) is skipped and listed in
+    ``model.skipped`` with its reason, and the rest of the file is read. Only what makes
+    the file unreadable as a whole (sections, Global delimiters, units) is refused.
+    """
     src = _Source(path)
-    lines = _split_lines(data)
-    sec = _sections(lines, src)
+    lenient = not strict
+    notes: list = [] if lenient else None
+    lines = _split_lines(data, lenient, notes)
+    sec = _sections(lines, src, lenient, notes)
     start = "\n".join(line[:72].rstrip() for _, line in sec["S"])
-    header, pd, rd = _parse_global(sec["G"], src)
+    header, pd, rd, defaulted = _parse_global(sec["G"], src, notes)
 
     dlines, plines = sec["D"], sec["P"]
     n = len(dlines) // 2
-    directory = []
+    skipped: dict = {}
+    directory: list = [None] * n
     for i in range(n):
         (l1, a), (l2, b) = dlines[2 * i], dlines[2 * i + 1]
-        etype = _field_int(a[0:8], src, l1, "field 1 (entity type)")
-        if _field_int(b[0:8], src, l2, "field 11 (entity type)") != etype:
-            src.error(f"entity type {b[0:8].strip()!r} differs from {a[0:8].strip()!r} on the line before", l2)
-        ptr = _field_int(a[8:16], src, l1, "field 2 (parameter data pointer)")
-        tr = _field_int(a[48:56], src, l1, "field 7 (transformation matrix)")
-        status = a[64:72]
-        if not all(c in " 0123456789" for c in status):  # ASCII digits only
-            src.error(f"Directory Entry field 9 (status number): expected digits, got {status!r}", l1)
-        count = _field_int(b[24:32], src, l2, "field 14 (parameter line count)")
-        form = _field_int(b[32:40], src, l2, "field 15 (form number)")
-        level = _field_int(a[32:40], src, l1, "field 5 (level)")
-        color = _field_int(b[16:24], src, l2, "field 13 (color)")
-        label = b[56:64].strip()
-        subscript = _field_int(b[64:72], src, l2, "field 19 (subscript)")
-        if count < 1 or ptr < 1 or ptr + count - 1 > len(plines):
-            src.error(f"parameter data lines {ptr}..{ptr + count - 1} are outside the Parameter Data "
-                      f"section (1..{len(plines)})", l1)
-        if tr < 0 or tr % 2 == 0 and tr != 0 or tr > 2 * n - 1:
-            src.error(f"Directory Entry field 7: dangling transformation matrix pointer {tr}", l1)
-        directory.append((etype, ptr, count, form, status, level, color, label, subscript, tr, l1))
+        try:
+            etype = _field_int(a[0:8], src, l1, "field 1 (entity type)")
+            if _field_int(b[0:8], src, l2, "field 11 (entity type)") != etype:
+                src.error(f"entity type {b[0:8].strip()!r} differs from {a[0:8].strip()!r} on the line before", l2)
+            ptr = _field_int(a[8:16], src, l1, "field 2 (parameter data pointer)")
+            tr = _field_int(a[48:56], src, l1, "field 7 (transformation matrix)")
+            status = a[64:72]
+            if not all(c in " 0123456789" for c in status):  # ASCII digits only
+                src.error(f"Directory Entry field 9 (status number): expected digits, got {status!r}", l1)
+            count = _field_int(b[24:32], src, l2, "field 14 (parameter line count)")
+            form = _field_int(b[32:40], src, l2, "field 15 (form number)")
+            level = _field_int(a[32:40], src, l1, "field 5 (level)")
+            color = _field_int(b[16:24], src, l2, "field 13 (color)")
+            label = b[56:64].strip()
+            subscript = _field_int(b[64:72], src, l2, "field 19 (subscript)")
+            if count < 1 or ptr < 1 or ptr + count - 1 > len(plines):
+                src.error(f"parameter data lines {ptr}..{ptr + count - 1} are outside the Parameter Data "
+                          f"section (1..{len(plines)})", l1)
+            if tr < 0 or tr % 2 == 0 and tr != 0 or tr > 2 * n - 1:
+                src.error(f"Directory Entry field 7: dangling transformation matrix pointer {tr}", l1)
+        except IgesError as exc:
+            if strict:
+                raise
+            t = _parse_int(a[0:8].strip()) or 0
+            skipped[i] = SkippedEntity(2 * i + 1, t, 0, str(exc), l1)
+            continue
+        directory[i] = (etype, ptr, count, form, status, level, color, label, subscript, tr, l1)
 
     built: list = [None] * n
     visiting = [False] * n
+    raw_refs: dict = {}
+    check = check_structure
+    if lenient:
+        from .foreign import _lenient_builders, check_lenient
 
-    def build(i: int, depth: int, role: str, referrer_line: int) -> Entity:
+        lenient_builders = {**BUILDERS, **_lenient_builders()}
+        check = check_lenient
+
+    def build(i: int, depth: int, role: str, referrer_line: int):
         if built[i] is not None:
             return built[i]
+        if i in skipped:
+            return skipped[i]
         if visiting[i]:
             src.error(f"recursive reference: entity at DE {2 * i + 1} ({role}) refers back to itself",
                       referrer_line)
         if depth > MAX_REFERENCE_DEPTH:
             src.error(f"references nested deeper than {MAX_REFERENCE_DEPTH}", referrer_line)
         visiting[i] = True
+        try:
+            record = _build_one(i, depth)
+        except IgesError as exc:
+            visiting[i] = False
+            if strict:
+                raise
+            etype, form, l1 = directory[i][0], directory[i][3], directory[i][10]
+            skipped[i] = SkippedEntity(2 * i + 1, etype, form, str(exc), l1)
+            return skipped[i]
+        visiting[i] = False
+        built[i] = record
+        return record
+
+    def _build_one(i: int, depth: int):
         etype, ptr, count, form, status, level, color, label, subscript, tr, l1 = directory[i]
         first_line = plines[ptr - 1][0]
         chunks = []
         seq = 2 * i + 1
+        expected = f"{seq:7d}"
         for k in range(ptr - 1, ptr - 1 + count):
             ln, text = plines[k]
-            back = text[65:72].strip()
-            if not _DIGITS.fullmatch(back) or int(back) != seq:
-                src.error(f"parameter line points back to DE {text[65:72].strip()!r}; expected {seq}", ln)
+            if text[65:72] != expected:  # the usual right-justified form, else check properly
+                back = text[65:72].strip()
+                if not _DIGITS.fullmatch(back) or int(back) != seq:
+                    src.error(f"parameter line points back to DE {text[65:72].strip()!r}; expected {seq}", ln)
             chunks.append(text[:64])
         data = "".join(chunks)
 
@@ -577,42 +778,69 @@ def parse_iges(data, path=None) -> IgesModel:
         if not tokens or _parse_int(tokens[0]) != etype:
             src.error(f"{where}: parameter data start with {str(tokens[0])[:20] if tokens else ''!r}, "
                       f"not the entity type {etype}", first_line)
+        if lenient:
+            raw_refs[i] = _raw_pointers(etype, tokens, n)
         p = _Params(tokens, src, where, first_line, line_of_index, n)
 
         def resolve(j, what):
-            return build(j, depth + 1, what, first_line)
+            got = build(j, depth + 1, what, first_line)
+            if isinstance(got, SkippedEntity):
+                src.error(f"{where}: its {what} (DE {got.sequence}, type {got.entity_type}) was skipped: "
+                          f"{got.reason}", first_line)
+            return got
 
         info = DirectoryInfo(sequence=seq, line=l1, parameter_line=first_line, form=form,
                              status=status, level=level, color=color)
         common = dict(label=label, subscript=subscript, directory=info)
         if tr:
             t = build((tr - 1) // 2, depth + 1, "transformation matrix", l1)
+            if isinstance(t, SkippedEntity):
+                src.error(f"{where}: its transformation matrix (DE {tr}) was skipped: {t.reason}", l1)
             if not isinstance(t, TransformationMatrix):
                 src.error(f"{where}: field 7 points to {t.describe()}, not a transformation matrix", l1)
             common["transform"] = t
+        builders = BUILDERS if strict else lenient_builders
         try:
-            if etype in BUILDERS:
-                cls, fn = BUILDERS[etype]
+            if etype in builders:
+                cls, fn = builders[etype]
                 record = cls(**fn(p, resolve, form), **common)
             else:
                 record = GenericEntity(entity_type=etype, entity_form=form, parameters=tuple(tokens[1:]), **common)
-            check_structure(record)
+            check(record)
         except IgesError as exc:
             if exc.line is not None:
                 raise
             src.error(f"{where}: {exc}", first_line)
         except BladesmithError as exc:
             src.error(f"{where}: {exc}", first_line)
-        visiting[i] = False
-        built[i] = record
         return record
 
     for i in range(n):
-        build(i, 0, "entity", directory[i][10])
-    return IgesModel(entities=tuple(built), header=header, start=start, path=src.path)
+        if directory[i] is not None:
+            build(i, 0, "entity", directory[i][10])
+    if strict:
+        return IgesModel(entities=tuple(built), header=header, start=start, path=src.path)
+    entities = tuple(e for e in built if e is not None)
+    # children of skipped entities, and entities the file marks as dependent (DE status
+    # digits 3-4 non-zero, IGES 5.3 §2.2.4.4.9), are not independent roots
+    dependent = set()
+    # (and of entities read only generically, such as 190-198 surfaces under a skipped face)
+    below_skipped = {j for i in skipped for j in raw_refs.get(i, ())}
+    below_skipped |= {j for i, e in enumerate(built) if isinstance(e, GenericEntity) for j in raw_refs.get(i, ())}
+    for i, e in enumerate(built):
+        if e is None:
+            continue
+        if i in below_skipped:
+            dependent.add(id(e))
+        st = e.directory.status if e.directory is not None else ""
+        if len(st) == 8 and st[2:4].strip() not in ("", "0", "00"):
+            dependent.add(id(e))
+    return IgesModel(entities=entities, header=header, start=start, path=src.path,
+                     skipped=tuple(skipped[k] for k in sorted(skipped)), notes=tuple(notes),
+                     defaulted=defaulted, dependent=frozenset(dependent))
 
 
-def read_iges(path) -> IgesModel:
+def read_iges(path, *, strict: bool = True) -> IgesModel:
     """Read an IGES file (IGES 5.3 fixed form) into an :class:`IgesModel`."""
     p = os.fspath(path)
     try:
@@ -623,4 +851,4 @@ def read_iges(path) -> IgesModel:
             data = f.read()
     except OSError as exc:
         raise IgesError(f"cannot read the file: {exc}", path=p) from exc
-    return parse_iges(data, path=p)
+    return parse_iges(data, path=p, strict=strict)

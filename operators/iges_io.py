@@ -15,13 +15,13 @@ reference blade as 128 and the hub sector trimmed by the blade footprint as a 14
 120, in the propeller's own coordinates. Rotated copies of a blade are rotated copies of
 these surfaces, which a mesher makes itself.
 
-Import creates exact NURBS objects for 126/128 (and 100, 110, 112, 114, 120 converted to
-B-splines); a trimmed surface (144) comes in as its untrimmed surface plus its trimming
-curves, and the report says so. A failure leaves the scene as it was.
+Import (:func:`import_file`) reads leniently through :mod:`..iges.importer`: exact NURBS
+objects at the file's units and placement, trimmed faces as meshes inside their loops
+that keep the exact 144 as ``bladesmith_iges_exact`` (export writes it back exactly, moved
+with the object), and a report of every entity type skipped and why. A refusal leaves
+the scene as it was.
 """
 from __future__ import annotations
-
-import os
 
 import bpy
 import numpy as np
@@ -30,22 +30,15 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from ..geometry.errors import BladesmithError
 from ..geometry.nurbs import BSplineCurve, BSplineSurface
-from ..geometry.nurbs.fitting import approximate
 from ..iges import (
     METRES_PER_UNIT,
-    TrimmedSurfaceGeometry,
     curve_from_geometry,
-    read_iges,
     surface_from_geometry,
     write_iges,
 )
-from ..iges.convert import surface_pieces, surface_points, surface_range
+from ..iges.convert import surface_pieces
 from .nurbs_objects import curve_to_object, object_to_geometry, remove_object, surface_to_object
 from .progress import progress_callback
-
-#: Trimming curves of an imported 144 are approximated on the surface to this fraction of
-#: the surface's size (they have no exact model-space form when the file gives none).
-TRIM_CURVE_TOL = 1e-6
 
 EXPORTABLE_TYPES = {"SURFACE", "CURVE"}
 
@@ -123,8 +116,21 @@ def export_objects(objects, filepath: str, units: str = "M", progress=None) -> d
         counts["propellers"] += 1
         counts["surfaces"] += len(found) - 1
         counts["trimmed"] += 1
-    objects = [o for o in objects if o.type in EXPORTABLE_TYPES and propeller.find_root(o) not in roots]
+    objects = [o for o in objects if (o.type in EXPORTABLE_TYPES or o.get(EXACT_KEY) is not None)
+               and propeller.find_root(o) not in roots]
     for i, obj in enumerate(objects):
+        if obj.get(EXACT_KEY) is not None:
+            # an imported trimmed face (or surface shown as a mesh): its exact entity
+            from ..iges.importer import placed_exact_records
+
+            try:
+                found = placed_exact_records(str(obj[EXACT_KEY]), np.array(obj.matrix_world), scale)
+            except BladesmithError as exc:
+                raise type(exc)(f"object '{obj.name}': {exc}") from None
+            records.extend(found)
+            counts["trimmed" if any(r.type_number == 144 for r in found) else "surfaces"] += len(found)
+            counts["objects"] += 1
+            continue
         try:
             pieces = _world_geometry(obj)
         except BladesmithError as exc:
@@ -148,68 +154,82 @@ def export_objects(objects, filepath: str, units: str = "M", progress=None) -> d
     return counts
 
 
-def _trim_curve_on_surface(surface_record, curve: BSplineCurve, size: float) -> BSplineCurve:
-    """A model-space B-spline of S(c(t)) within :data:`TRIM_CURVE_TOL` of ``size``.
+#: Custom property of an imported mesh that stands for an exact entity (a trimmed face, or
+#: a surface Blender cannot show): the IGES text of that entity in metres, for export.
+EXACT_KEY = "bladesmith_iges_exact"
 
-    The loop ``c`` is in the IGES parameter space of the basis surface record (for a 120,
-    v is the rotation angle), so S is evaluated through the record, not through its
-    NURBS conversion, whose parameterisation differs."""
-    a, b = curve.domain
-    (u0, u1), (v0, v1) = surface_range(surface_record)
 
-    def on_surface(t):
-        uv = curve.evaluate(t)
-        return surface_points(surface_record, np.clip(uv[..., 0], u0, u1), np.clip(uv[..., 1], v0, v1))
-
-    return approximate(on_surface, TRIM_CURVE_TOL * size, degree=3, domain=(a, b))
+def _mesh_to_object(item, collection):
+    """A MESH object of an import item's triangles, its exact entity stored on it."""
+    mesh = bpy.data.meshes.new(item.name)
+    obj = None
+    try:
+        V = np.asarray(item.mesh.vertices, dtype=np.float64)
+        F = np.asarray(item.mesh.triangles, dtype=np.int64)
+        mesh.vertices.add(len(V))
+        mesh.vertices.foreach_set("co", V.astype(np.float32).ravel())
+        mesh.loops.add(3 * len(F))
+        mesh.loops.foreach_set("vertex_index", F.astype(np.int32).ravel())
+        mesh.polygons.add(len(F))
+        mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * len(F), 3, dtype=np.int32))
+        mesh.polygons.foreach_set("loop_total", np.full(len(F), 3, dtype=np.int32))
+        mesh.update(calc_edges=True)
+        mesh.validate()
+        obj = bpy.data.objects.new(item.name, mesh)
+        if item.exact is not None:
+            obj[EXACT_KEY] = item.exact
+        (collection or bpy.context.scene.collection).objects.link(obj)
+    except BaseException:
+        if obj is not None:
+            bpy.data.objects.remove(obj, do_unlink=True)
+        if mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+        raise
+    return obj
 
 
 def import_file(filepath: str, collection, progress=None) -> dict:
     """Create objects for the curves and surfaces of an IGES file in ``collection``.
 
-    Returns counts; on any :class:`BladesmithError` the objects made so far are removed
-    and the error propagates, so the scene is unchanged.
+    The file is read leniently (:func:`..iges.importer.import_path`): units and placement
+    applied, unsupported or malformed entities skipped and reported, trimmed faces as
+    meshes inside their loops that keep the exact 144 for export. Returns counts and the
+    report; on any error the objects made so far are removed and the error propagates, so
+    the scene is unchanged.
     """
-    model = read_iges(filepath)
-    unit = model.header.unit_name.upper() if model.header.unit_name else "M"
-    factor = METRES_PER_UNIT.get(unit.lower(), 1.0) / (model.header.model_scale or 1.0)
-    items = model.to_geometry()
+    from ..iges.importer import import_path, surface_as_mesh
+
+    report = import_path(filepath)
     created = []
-    counts = {"surfaces": 0, "curves": 0, "trimmed": 0, "trim_curves": 0}
-    base = os.path.splitext(os.path.basename(filepath))[0]
-
-    def scaled(g):
-        P = np.asarray(g.control_points) * factor
-        if isinstance(g, BSplineSurface):
-            return BSplineSurface(g.degree_u, g.degree_v, g.knots_u, g.knots_v, P, g.weights)
-        return BSplineCurve(g.degree, g.knots, P, g.weights)
-
+    counts = {"surfaces": 0, "curves": 0, "trimmed": 0, "meshed": 0, "notes": list(report.notes)}
     try:
-        for i, (record, geometry) in enumerate(items):
-            name = (record.label or f"{base}.{record.type_number}").strip() or base
-            if isinstance(geometry, TrimmedSurfaceGeometry):
-                created.append(surface_to_object(scaled(geometry.surface), name, collection))
-                counts["trimmed"] += 1
-                for loop in ([geometry.outer] if geometry.outer else []) + list(geometry.inner):
-                    for c in loop:
-                        trim = _trim_curve_on_surface(record.surface, c, geometry.surface.size())
-                        created.append(curve_to_object(scaled(trim), f"{name}.trim", collection))
-                        counts["trim_curves"] += 1
-            elif isinstance(geometry, BSplineSurface):
-                created.append(surface_to_object(scaled(geometry), name, collection))
-                counts["surfaces"] += 1
+        for i, item in enumerate(report.items):
+            if item.kind == "surface":
+                try:
+                    created.append(surface_to_object(item.geometry, item.name, collection))
+                    counts["surfaces"] += 1
+                except BladesmithError as exc:
+                    # Blender cannot show this one as NURBS: show a mesh, keep it exact
+                    mesh_item = surface_as_mesh(item.geometry, item.name)
+                    created.append(_mesh_to_object(mesh_item, collection))
+                    counts["meshed"] += 1
+                    counts["notes"].append(f"{item.name}: shown as a mesh ({exc})")
+            elif item.kind == "curve":
+                created.append(curve_to_object(item.geometry, item.name, collection))
+                counts["curves"] += 1
             else:
-                for c in geometry if isinstance(geometry, list) else [geometry]:
-                    for piece in c if isinstance(c, list) else [c]:
-                        created.append(curve_to_object(scaled(piece), name, collection))
-                        counts["curves"] += 1
+                created.append(_mesh_to_object(item, collection))
+                counts["trimmed" if item.trimmed else "meshed"] += 1
+            if item.note:
+                counts["notes"].append(f"{item.name}: {item.note}")
             if progress:
-                progress((i + 1) / len(items))
-    except BladesmithError:
+                progress((i + 1) / len(report.items))
+    except BaseException:
         for obj in created:
             remove_object(obj)
         raise
     counts["objects"] = created
+    counts["report"] = report
     return counts
 
 
@@ -273,13 +293,18 @@ class IMPORT_SCENE_OT_iges(bpy.types.Operator, ImportHelper):
             return {"CANCELLED"}
         finally:
             wm.progress_end()
-        message = f"Imported {counts['surfaces']} surfaces and {counts['curves']} curves"
-        if counts["trimmed"]:
-            message += (
-                f"; {counts['trimmed']} trimmed surfaces came in untrimmed, with their "
-                f"{counts['trim_curves']} trimming curves as separate curve objects"
-            )
-        self.report({"INFO"}, message)
+        report = counts["report"]
+        u = report.units
+        message = (f"Imported {counts['surfaces']} surfaces, {counts['trimmed']} trimmed faces (meshes inside "
+                   f"their trim loops, exact data kept) and {counts['curves']} curves; units {u.name} "
+                   f"(x {u.factor:g} m)")
+        if counts["meshed"]:
+            message += f"; {counts['meshed']} surfaces shown as meshes"
+        if report.skipped:
+            message += f"; skipped {report.skipped_summary()}"
+        self.report({"WARNING"} if report.skipped else {"INFO"}, message)
+        for note in counts["notes"]:
+            self.report({"INFO"}, note)
         return {"FINISHED"}
 
 

@@ -1,0 +1,85 @@
+"""Benchmark: read the 100-surface IGES file (100 bicubic B-spline surfaces of 40 x 40
+control points, written by ``bench_iges.py``'s surfaces) with Bladesmith and OpenCASCADE.
+
+Prints medians, measured in the same run on the same file, of
+* ``read_iges`` (strict parse into records),
+* ``parse_iges(strict=False)`` + ``import_model`` (what File > Import runs before it makes
+  Blender objects: lenient parse, units, placement, B-spline geometry),
+* OpenCASCADE ``IGESControl_Reader`` ReadFile + TransferRoots,
+and the ratios ours / OCC. Never part of pass/fail (ARCHITECTURE.md, house style 10).
+
+    .venv/bin/python bench/bench_iges_read.py [--repeat 5] [--surfaces 100] [--size 40]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import tempfile
+import time
+
+from bench_iges import random_surfaces
+from common import load_checkout
+
+
+def time_call(fn, repeat: int) -> float:
+    fn()  # warm-up (imports, caches)
+    out = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t)
+    return statistics.median(out)
+
+
+def occ_read(path):
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.IGESControl import IGESControl_Reader
+
+    reader = IGESControl_Reader()
+    if reader.ReadFile(str(path)) != IFSelect_RetDone:
+        raise RuntimeError("OCC could not read the file")
+    reader.TransferRoots()
+    return reader.OneShape()
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--surfaces", type=int, default=100)
+    ap.add_argument("--size", type=int, default=40)
+    args = ap.parse_args(argv)
+
+    load_checkout()
+    from bladesmith.iges import read_iges, surface_from_geometry, write_iges
+    from bladesmith.iges.importer import import_model
+    from bladesmith.iges.reader import parse_iges
+
+    records = [surface_from_geometry(s) for s in random_surfaces(args.surfaces, args.size)]
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "bench.igs")
+        write_iges(path, records, units="m")
+        size = os.path.getsize(path)
+
+        def lenient():
+            with open(path, "rb") as f:
+                data = f.read()
+            return import_model(parse_iges(data, path=path, strict=False), len(data))
+
+        t_strict = time_call(lambda: read_iges(path), args.repeat)
+        t_import = time_call(lenient, args.repeat)
+        try:
+            t_occ = time_call(lambda: occ_read(path), args.repeat)
+        except ImportError:
+            t_occ = None
+    print(f"file: {args.surfaces} bicubic surfaces of {args.size}x{args.size} control points, {size / 1e6:.1f} MB")
+    print(f"bladesmith read_iges (strict parse): median {t_strict:.3f} s over {args.repeat} runs")
+    print(f"bladesmith lenient parse + import_model: median {t_import:.3f} s")
+    if t_occ is not None:
+        print(f"OpenCASCADE IGESControl_Reader ReadFile + TransferRoots: median {t_occ:.3f} s")
+        print(f"ratio read_iges / OCC: {t_strict / t_occ:.2f}; ratio import / OCC: {t_import / t_occ:.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

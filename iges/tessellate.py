@@ -1,0 +1,193 @@
+"""Triangle meshes of trimmed surfaces, for display only (Blender has no trimmed NURBS).
+
+A trimmed face is tessellated in its parameter plane: the trimming loops become closed
+polylines (uv), a regular grid fills the inside, points too near a loop are dropped, the
+lot is Delaunay-triangulated (scipy.spatial.Delaunay) and triangles whose centroid lies
+outside the region (even-odd rule: inside the outer loop, outside every hole) are
+removed. The parameter plane is first stretched by the mean speeds |S_u| and |S_v| so
+that triangles are roughly isotropic on the surface.
+
+The mesh is refined until the largest chordal deviation, measured at triangle centroids
+and edge midpoints against the exact surface, is within the display tolerance (each
+failing probe point becomes a vertex), or until the point budget or the rounds are spent; the achieved deviation is returned so that a miss is reported,
+never hidden.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import Delaunay, QhullError, cKDTree
+
+from ..geometry.errors import IgesError
+
+#: Refinement rounds (each adds the failing probe points as vertices) before giving up.
+MAX_ROUNDS = 8
+#: First grid: this many cells across the larger side of the loop's bounding box.
+START_CELLS = 16
+#: Refinement adds no vertex nearer than this fraction of the face's larger side to another.
+MIN_SPACING = 1e-4
+#: Triangles of less (doubled) area than this fraction of the face's larger side squared are dropped.
+SLIVER_AREA = 1e-12
+#: Least stretch of one parameter direction relative to the other.
+MIN_STRETCH = 1e-3
+#: Most vertices of one face's display mesh (a tolerance missed at this size is reported).
+MAX_FACE_POINTS = 20_000
+#: Edges processed at once by the point-in-polygon test (bounds the memory to
+#: points x this many booleans).
+EDGE_CHUNK = 256
+
+
+@dataclass(frozen=True)
+class TrimmedMesh:
+    """vertices (n, 3) float64 on the surface; triangles (m, 3) int; uv (n, 2) parameters;
+    deviation: largest measured distance between the mesh and the surface."""
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    uv: np.ndarray
+    deviation: float
+
+
+def inside(points: np.ndarray, loops: list) -> np.ndarray:
+    """Even-odd rule: True where ``points`` (k, 2) lie inside the region bounded by the
+    closed polylines ``loops`` (each (m, 2), last point joined to the first).
+
+    Points and edges are bucketed in horizontal bands (about sqrt(edges) of them), so each
+    point is tested only against the edges that span its band."""
+    points = np.asarray(points, dtype=np.float64)
+    odd = np.zeros(len(points), dtype=bool)
+    if not len(points):
+        return odd
+    A = np.concatenate(loops)
+    B = np.concatenate([np.roll(l, -1, axis=0) for l in loops])
+    ylo, yhi = np.minimum(A[:, 1], B[:, 1]), np.maximum(A[:, 1], B[:, 1])
+    keep = yhi > ylo  # horizontal edges never cross a horizontal ray
+    A, B, ylo, yhi = A[keep], B[keep], ylo[keep], yhi[keep]
+    py = points[:, 1]
+    lo, hi = float(py.min()), float(py.max())
+    nb = max(1, int(np.sqrt(len(A))))
+    width = (hi - lo) / nb or 1.0
+    band = np.clip(((py - lo) / width).astype(np.int64), 0, nb - 1)
+    order = np.argsort(band, kind="stable")
+    starts = np.searchsorted(band[order], np.arange(nb + 1))
+    first = np.clip(np.floor((ylo - lo) / width).astype(np.int64), 0, nb - 1)
+    last = np.clip(np.floor((yhi - lo) / width).astype(np.int64), 0, nb - 1)
+    for k in range(nb):
+        idx = order[starts[k] : starts[k + 1]]
+        if not len(idx):
+            continue
+        e = np.nonzero((first <= k) & (last >= k))[0]
+        if not len(e):
+            continue
+        px, pyk = points[idx, 0], py[idx]
+        for s in range(0, len(e), EDGE_CHUNK):
+            ee = e[s : s + EDGE_CHUNK]
+            x1, y1, x2, y2 = A[ee, 0], A[ee, 1], B[ee, 0], B[ee, 1]
+            cross = (y1[None, :] > pyk[:, None]) != (y2[None, :] > pyk[:, None])
+            xint = x1[None, :] + (pyk[:, None] - y1[None, :]) * ((x2 - x1) / (y2 - y1))[None, :]
+            odd[idx] ^= (np.count_nonzero(cross & (px[:, None] < xint), axis=1) % 2).astype(bool)
+    return odd
+
+
+def _resample(loop: np.ndarray, step: float, max_points: int) -> np.ndarray:
+    """The closed polyline ``loop`` with every segment longer than ``step`` subdivided."""
+    b = np.roll(loop, -1, axis=0)
+    seg = np.linalg.norm(b - loop, axis=1)
+    k = np.maximum(1, np.ceil(np.minimum(seg / step, max_points)).astype(np.int64))
+    if int(k.sum()) > max_points:
+        raise IgesError(f"meshing the trimmed face needs more than the budget of {max_points} points")
+    out = [loop[i] + (b[i] - loop[i]) * (np.arange(k[i])[:, None] / k[i]) for i in range(len(loop))]
+    return np.concatenate(out)
+
+
+def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> TrimmedMesh:
+    """Mesh of the region of the surface ``evaluate(u, v) -> (..., 3)`` bounded by
+    ``loops_uv`` (first the outer loop, then holes; each a closed polyline (m, 2) in the
+    surface's parameter space), with chordal deviation within ``tolerance`` if the budget
+    of ``max_points`` vertices allows (see :class:`TrimmedMesh`.deviation).
+    IgesError when the loops bound no area."""
+    max_points = min(int(max_points), MAX_FACE_POINTS)
+    loops_uv = [np.asarray(l, dtype=np.float64) for l in loops_uv if len(l) >= 3]
+    if not loops_uv:
+        raise IgesError("the trimming loops bound no area")
+    outer = loops_uv[0]
+    lo, hi = outer.min(axis=0), outer.max(axis=0)
+    span = hi - lo
+    if not np.all(span > 0) or not np.all(np.isfinite(span)):
+        raise IgesError(f"the outer trimming loop spans {span.tolist()} in (u, v): no area")
+    # metric stretch: mean speeds of S along u and v over the loop's box
+    g = np.linspace(0.0, 1.0, 9)
+    U, V = np.meshgrid(lo[0] + g * span[0], lo[1] + g * span[1], indexing="ij")
+    X = evaluate(U, V)
+    su = float(np.mean(np.linalg.norm(np.diff(X, axis=0), axis=-1))) / (span[0] / 8) + 1e-300
+    sv = float(np.mean(np.linalg.norm(np.diff(X, axis=1), axis=-1))) / (span[1] / 8) + 1e-300
+    scale = np.array([su, sv])
+    # a direction in which the surface hardly moves (a pole, a degenerate patch) still gets
+    # points: its stretch is floored at a fraction of the other's
+    scale = np.maximum(scale, MIN_STRETCH * scale.max())
+    if not np.all(np.isfinite(scale)):
+        raise IgesError("the surface is not finite over its trimming loops")
+    mloops = [(l - lo) * scale for l in loops_uv]
+    width = span * scale
+    h = float(width.max()) / START_CELLS
+    best = None
+    B = np.concatenate([_resample(l, h, max_points) for l in mloops])
+    nx, ny = (np.ceil(width / h).astype(int) + 1).tolist()
+    gx = np.linspace(0.0, width[0], nx)
+    gy = np.linspace(0.0, width[1], ny)
+    G = np.stack(np.meshgrid(gx, gy, indexing="ij"), axis=-1).reshape(-1, 2)
+    d, _ = cKDTree(B).query(G)
+    G = G[(d > 0.5 * h)]
+    if len(G):
+        G = G[inside(G, mloops)]
+    P = np.unique(np.concatenate([B, G]), axis=0)
+    if len(P) < 3:
+        raise IgesError("the trimming loops bound no area")
+    if len(P) > max_points:
+        raise IgesError(f"meshing the trimmed face needs more than the budget of {max_points} points")
+    X = evaluate(*(P / scale + lo).T)
+    floor = MIN_SPACING * h * START_CELLS
+    weights = (np.array([1, 1, 1]) / 3, np.array([0.5, 0.5, 0]), np.array([0, 0.5, 0.5]), np.array([0.5, 0, 0.5]))
+    for _ in range(MAX_ROUNDS):
+        try:
+            tri = Delaunay(P).simplices
+        except QhullError:  # degenerate: all loop points on a line
+            raise IgesError("the trimming loops are degenerate (all points on a line)") from None
+        tri = tri[inside(P[tri].mean(axis=1), mloops)]
+        # Qhull leaves slivers of (almost) zero area along straight runs of loop points:
+        # they show nothing and their chords are not part of the surface
+        e1, e2 = P[tri[:, 1]] - P[tri[:, 0]], P[tri[:, 2]] - P[tri[:, 0]]
+        tri = tri[np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) > SLIVER_AREA * float(width.max()) ** 2]
+        if not len(tri):
+            raise IgesError("the trimming loops bound no area")
+        if not np.all(np.isfinite(X)):
+            raise IgesError("the surface is not finite over its trimming loops")
+        # chordal deviation at centroids and edge midpoints
+        probes = np.concatenate([np.einsum("k,mkd->md", w, P[tri]) for w in weights])
+        linear = np.concatenate([np.einsum("k,mkd->md", w, X[tri]) for w in weights])
+        Xp = evaluate(*(probes / scale + lo).T)
+        dev = np.linalg.norm(Xp - linear, axis=1)
+        # probes outside the region (edges of triangles over a concave part of a loop)
+        # evaluate the surface where the face is not: they do not count
+        dev[~inside(probes, mloops)] = 0.0
+        deviation = float(dev.max()) if dev.size else 0.0
+        best = TrimmedMesh(X, tri.astype(np.int64), P / scale + lo, deviation)
+        bad = dev > tolerance
+        if not bad.any():
+            break
+        # refine where the mesh misses: the failing probe points become vertices, but not
+        # nearer than ``floor`` to a vertex (nearly coincident points stall Qhull, and a
+        # miss that survives at that spacing is a singular spot, reported by ``deviation``)
+        cand, cx = probes[bad], Xp[bad]
+        keep = cKDTree(P).query(cand)[0] > floor
+        cand, cx = cand[keep], cx[keep]
+        _, k = np.unique(np.round(cand / floor), axis=0, return_index=True)
+        cand, cx = cand[k], cx[k]
+        if not len(cand) or len(P) + len(cand) > max_points:
+            break
+        P = np.concatenate([P, cand])
+        X = np.concatenate([X, cx])
+    if best is None:
+        raise IgesError(f"meshing the trimmed face within budget of {max_points} points is not possible")
+    return best

