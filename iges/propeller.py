@@ -121,13 +121,28 @@ def _check_consistency(model, blade_items, sector) -> None:
                                 f"and the tip (r = {0.5 * D:.6g} m) of this propeller")
 
 
-def hub_records(sector, *, scale: float = 1.0, model_curves: bool = False) -> TrimmedSurface:
-    """The hub sector as a 144 over a 120 (see the module docstring); 3-D coordinates times
-    ``scale`` (file units per metre); parameter-space curves are in (ξ_h, θ) as they are."""
+def _hub_surface(sector, angle_range, scale: float) -> SurfaceOfRevolution:
     axis = Line(start=[0.0, 0.0, 0.0], end=[0.0, 0.0, -1.0])
     spine = curve_from_geometry(sector.generatrix, scale=scale, label="SPINE")
-    a0, a1 = map(float, sector.angle_range)
-    surface = SurfaceOfRevolution(axis=axis, generatrix=spine, start_angle=a0, end_angle=a1)
+    a0, a1 = map(float, angle_range)
+    return SurfaceOfRevolution(axis=axis, generatrix=spine, start_angle=a0, end_angle=a1)
+
+
+def _root_loop(surface, pcurves, edges, scale: float) -> CurveOnSurface:
+    """A 142 along a blade root: B = the composite of the root's images in (s, θ), C = the
+    composite of the root edges themselves (the blade surfaces' v = 0 rows, as 126 with the
+    same control points), PREF = 2: C is the curve both faces share."""
+    param = CompositeCurve(curves=[curve_from_geometry(c) for c in pcurves])
+    model = CompositeCurve(curves=[curve_from_geometry(c, scale=scale) for c in edges])
+    return CurveOnSurface(surface=surface, parameter_curve=param, model_curve=model, creation=2, preferred=2)
+
+
+def hub_records(sector, *, scale: float = 1.0, model_curves: bool = False) -> TrimmedSurface:
+    """The hub sector as a 144 over a 120 (see the module docstring); 3-D coordinates times
+    ``scale`` (file units per metre); parameter-space curves are in (ξ_h, θ) as they are.
+    A sector built from the blade (``hub_sector(..., blade=...)``) is trimmed by the blade
+    root edge itself (:func:`_root_loop`)."""
+    surface = _hub_surface(sector, sector.angle_range, scale)
 
     pieces = []
     for c in sector.outer_loop:
@@ -146,9 +161,82 @@ def hub_records(sector, *, scale: float = 1.0, model_curves: bool = False) -> Tr
         pref = 3
     outer = CurveOnSurface(surface=surface, parameter_curve=outer_param, model_curve=outer_model,
                            creation=0, preferred=pref)
-    inner = CurveOnSurface(surface=surface, parameter_curve=inner_param, model_curve=inner_model,
-                           creation=2, preferred=pref)
+    if sector.root_edges is not None:
+        inner = _root_loop(surface, sector.inner_loop, sector.root_edges, scale)
+    else:
+        inner = CurveOnSurface(surface=surface, parameter_curve=inner_param, model_curve=inner_model,
+                               creation=2, preferred=pref)
     return TrimmedSurface(surface=surface, outer=outer, inner=(inner,), label=HUB_LABEL)
+
+
+def turned_blade(items, rotation) -> list:
+    """(label, surface) of a blade turned by the 3x3 ``rotation``: every control net times
+    the matrix once (B-splines are affinely invariant), so a turned surface's edge rows are
+    the turned rows of the reference surface, the same numbers wherever they are used."""
+    R = np.asarray(rotation, dtype=np.float64)
+    out = []
+    for label, s in items:
+        out.append((label, BSplineSurface(s.degree_u, s.degree_v, s.knots_u, s.knots_v,
+                                          s.control_points @ R.T, s.weights)))
+    return out
+
+
+def full_propeller_geometry(model, blade, sector):
+    """The whole propeller as plain geometry: (blades, holes, angle_range).
+
+    blades: Z lists of (label, surface), blade k the reference blade turned by 2πk/Z
+    (:meth:`PropellerModel.blade_rotation`). holes: Z pairs (pcurves, root edges) trimming
+    the whole hub, blade k's footprint the reference loop moved by 2πk/Z in θ and its 3-D
+    curves the root rows of turned blade k. angle_range: a full turn with the seam between
+    two blades (:func:`~bladesmith.geometry.propeller.hub_sector.full_hub_angle_range`).
+    The sector must have been built from ``blade`` (its inner loop is the root edge)."""
+    from ..geometry.propeller.hub_sector import full_hub_angle_range, oriented_root_edges, turned_pcurves
+
+    if sector.root_edges is None:
+        raise GeometryError("a full propeller needs the hub sector built from the blade surfaces "
+                            "(hub_sector(model, blade=...)), so the hub is trimmed by the blade root edge itself")
+    items = _blade_surfaces(blade)
+    _check_consistency(model, items, sector)
+    names = dict((label, name) for name, label in BLADE_SURFACES)
+    blades, holes = [], []
+    for k in range(model.blades):
+        turned = items if k == 0 else turned_blade(items, model.blade_rotation(k))
+        blades.append(turned)
+        by_name = {names[label]: surface for label, surface in turned if label in names}
+        holes.append((turned_pcurves(sector, k), oriented_root_edges(sector, by_name)))
+    return blades, holes, full_hub_angle_range(sector)
+
+
+def full_propeller_iges_entities(model, blade, hub_sector, units: str = "m") -> list:
+    """IGES records of the whole propeller: Z blades of five 128 each, and the whole hub as
+    one 144 over a 120 turned a full turn, whose outer boundary is the boundary of its
+    parameter domain (N1 = 0; the poles and the seam are the surface's own) and whose Z
+    inner loops are the blade root edges (:func:`_root_loop`). Every blade face and the hub
+    face share their junction curve, so the faces sew into one closed shell at any
+    tolerance; no sector edges are written. See :func:`full_propeller_geometry`."""
+    key = units.lower() if isinstance(units, str) else units
+    if key not in UNITS or key not in METRES_PER_UNIT:
+        raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}")
+    scale = 1.0 / METRES_PER_UNIT[key]
+    blades, holes, angle_range = full_propeller_geometry(model, blade, hub_sector)
+    records = []
+    for k, turned in enumerate(blades):
+        records += [surface_from_geometry(s, scale=scale, label=f"{label[:6]}{k + 1:02d}"[-8:] if k else label)
+                    for label, s in turned]
+    surface = _hub_surface(hub_sector, angle_range, scale)
+    inner = [_root_loop(surface, pc, edges, scale) for pc, edges in holes]
+    records.append(TrimmedSurface(surface=surface, outer=None, inner=inner, label=HUB_LABEL))
+    return records
+
+
+def write_full_propeller_iges(path, model, blade, hub_sector, units: str = "m", *, resolution: float | None = None,
+                              **options) -> str:
+    """Write the whole propeller (:func:`full_propeller_iges_entities`) to ``path``
+    atomically. Returns the path."""
+    records = full_propeller_iges_entities(model, blade, hub_sector, units)
+    if resolution is None:
+        resolution = DEFAULT_RESOLUTION / METRES_PER_UNIT[units.lower()]
+    return write_iges(os.fspath(path), records, units=units, resolution=resolution, **options)
 
 
 def propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, model_curves: bool = False) -> list:
