@@ -52,6 +52,8 @@ HUB_LABEL = "HUB"
 #: A blade surface's boundary is "on the hub" when it comes this close to it, as a fraction
 #: of the diameter (only used to refuse blade surfaces that do not belong to this hub).
 ROOT_CHECK_FRACTION = 1e-2
+#: Samples per direction of each blade surface for that check.
+RANGE_CHECK_SAMPLES = 41
 
 
 def surface_continuity(surface: BSplineSurface) -> int:
@@ -115,7 +117,12 @@ def _check_consistency(model, blade_items, sector) -> None:
     R_hub = float(model.hub.radius)
     reach = ROOT_CHECK_FRACTION * D
     for label, s in blade_items:
-        r = np.hypot(s.control_points[..., 0], s.control_points[..., 1])
+        # the surface itself, not its control net: a finite tip chord is closed by a tip
+        # surface whose control points reach beyond R while the surface stays inside
+        # (Propeller definition: MAX_TIP_CHORD_RATIO)
+        (u0, u1), (v0, v1) = s.domain_u, s.domain_v
+        X = s.evaluate(np.linspace(u0, u1, RANGE_CHECK_SAMPLES)[:, None], np.linspace(v0, v1, RANGE_CHECK_SAMPLES)[None, :])
+        r = np.hypot(X[..., 0], X[..., 1])
         if r.max() < R_hub - reach or r.max() > 0.5 * D * (1.0 + ROOT_CHECK_FRACTION):
             raise GeometryError(f"blade surface {label} does not lie between the hub (r = {R_hub:.6g} m) "
                                 f"and the tip (r = {0.5 * D:.6g} m) of this propeller")
