@@ -238,3 +238,33 @@ def test_fluid_around_the_propeller_volume_meshes(mesh_case, tmp_path_factory):
     assert valid
     assert tets > 1000
     assert min_sicn > MIN_SICN, f"min SICN {min_sicn:.4g}"
+
+
+def test_turned_copies_of_the_reference_set_sew_into_one_valid_solid(case, tmp_path_factory):
+    """Hally's §11 set as a CFD engineer uses it: the reference blade and the hub sector
+    trimmed by the blade root edge, turned Z times in OCC and sewn at 1e-7 D: one closed
+    shell (the ±π/Z edges of neighbouring copies and the root junction all meet)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing, BRepBuilderAPI_Transform
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf
+    from OCP.TopAbs import TopAbs_SHELL
+    from OCP.TopoDS import TopoDS
+
+    from bladesmith.iges.propeller import write_propeller_iges
+
+    model, blade, sector, _ = built(case, tmp_path_factory)
+    D = 2.0 * model.blade.radius
+    path = write_propeller_iges(tmp_path_factory.mktemp("ref") / f"{case.name}.igs", model, blade, sector)
+    occ = read_with_occ(path)
+    assert occ.load_messages == [] and occ.transfer_messages == [] and len(occ.faces) == 6
+    sewing = BRepBuilderAPI_Sewing(SEWING_TOL_FRACTION * D * MM_PER_M)
+    for k in range(model.blades):
+        turn = gp_Trsf()
+        turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, -1)), 2.0 * np.pi * k / model.blades)  # θ sense
+        for face in occ.faces:
+            sewing.Add(BRepBuilderAPI_Transform(face, turn, True).Shape())
+    sewing.Perform()
+    assert sewing.NbFreeEdges() == 0 and sewing.NbMultipleEdges() == 0
+    shell = sewing.SewedShape()
+    assert shell.ShapeType() == TopAbs_SHELL
+    assert BRepCheck_Analyzer(BRepBuilderAPI_MakeSolid(TopoDS.Shell(shell)).Solid()).IsValid()
