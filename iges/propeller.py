@@ -214,6 +214,81 @@ def full_propeller_geometry(model, blade, sector):
     return blades, holes, full_hub_angle_range(sector)
 
 
+def _iso_uses(surface: BSplineSurface) -> list:
+    """The boundary of an untrimmed surface as one loop of edge uses (3-D curve, 2-D curve,
+    isoparametric) counter-clockwise in (u, v): v = v0 forwards, u = u1 forwards, v = v1
+    backwards, u = u0 backwards. The 3-D curves are the control rows of the net (the
+    surface's own boundary curves, exactly); each 2-D curve is the straight line in (u, v)
+    with the 3-D curve's parameter (so both run together)."""
+    from ..geometry.nurbs import BSplineCurve, reverse
+
+    (u0, u1), (v0, v1) = surface.domain_u, surface.domain_v
+    P, W = surface.control_points, surface.weights
+    Ku, Kv, p, q = surface.knots_u, surface.knots_v, surface.degree_u, surface.degree_v
+
+    def row(deg, knots, pts, w):
+        return BSplineCurve(deg, knots, np.array(pts), None if w is None else np.array(w))
+
+    def line(a, b, t0, t1):
+        return BSplineCurve(1, np.array([t0, t0, t1, t1]), np.array([a, b], dtype=np.float64))
+
+    bottom = (row(p, Ku, P[:, 0], None if W is None else W[:, 0]), line((u0, v0), (u1, v0), u0, u1))
+    right = (row(q, Kv, P[-1, :], None if W is None else W[-1, :]), line((u1, v0), (u1, v1), v0, v1))
+    top = (row(p, Ku, P[:, -1], None if W is None else W[:, -1]), line((u0, v1), (u1, v1), u0, u1))
+    left = (row(q, Kv, P[0, :], None if W is None else W[0, :]), line((u0, v0), (u0, v1), v0, v1))
+    return [(bottom[0], bottom[1], True), (right[0], right[1], True),
+            (reverse(top[0]), reverse(top[1]), True), (reverse(left[0]), reverse(left[1]), True)]
+
+
+def _hub_outer_uses(sector, angle_range) -> list:
+    """The outer boundary of the full-turn hub in (s, θ), counter-clockwise: the seam (the
+    spine turned to the start angle, exact: same knots and weights, s its parameter) from
+    the upstream to the downstream pole, the downstream pole (a degenerate edge), the seam
+    again backwards at the end angle (the same edge), the upstream pole."""
+    from ..geometry.nurbs import BSplineCurve, reverse
+
+    a0, a1 = map(float, angle_range)
+    S = sector.spine
+    rho, z = S.control_points[:, 0], S.control_points[:, 1]
+    seam = BSplineCurve(S.degree, S.knots, np.column_stack([rho * np.sin(a0), rho * np.cos(a0), z]), S.weights)
+    s0, s1 = map(float, S.domain)
+
+    def line(a, b, t0=0.0, t1=1.0):
+        return BSplineCurve(1, np.array([t0, t0, t1, t1]), np.array([a, b], dtype=np.float64))
+
+    up, down = seam.control_points[0], seam.control_points[-1]
+    return [(seam, line((s0, a0), (s1, a0), s0, s1), True),
+            (down.copy(), line((s1, a0), (s1, a1)), True),
+            (reverse(seam), reverse(line((s0, a1), (s1, a1), s0, s1)), True),
+            (up.copy(), line((s0, a1), (s0, a0)), True)]
+
+
+def full_propeller_brep_entities(model, blade, hub_sector, units: str = "m") -> list:
+    """The whole propeller as ONE IGES 186 manifold solid B-rep (with 502/504/508/510/514,
+    :mod:`.brep`): the faces of :func:`full_propeller_iges_entities` (5Z untrimmed 128s
+    bounded by their own boundary curves, the full-turn 120 with the Z blade root edges as
+    its loops and its own boundary as the outer one), every edge written once and used by
+    two faces, all face normals pointing out of the propeller (blade S_u × S_v, hub
+    h_ξ × h_θ)."""
+    from .brep import FaceSpec, solid_from_faces
+
+    key = units.lower() if isinstance(units, str) else units
+    if key not in UNITS or key not in METRES_PER_UNIT:
+        raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}")
+    scale = 1.0 / METRES_PER_UNIT[key]
+    blades, holes, angle_range = full_propeller_geometry(model, blade, hub_sector)
+    faces = []
+    for k, turned in enumerate(blades):
+        for label, s in turned:
+            record = surface_from_geometry(s, scale=scale, label=f"{label[:6]}{k + 1:02d}"[-8:] if k else label)
+            faces.append(FaceSpec(surface=record, loops=[_iso_uses(s)], outer=True))
+    hub = _hub_surface(hub_sector, angle_range, scale)
+    loops = [_hub_outer_uses(hub_sector, angle_range)]
+    loops += [[(edge, pc, False) for pc, edge in zip(pcs, edges)] for pcs, edges in holes]
+    faces.append(FaceSpec(surface=hub, loops=loops, outer=True))
+    return [solid_from_faces(faces, scale=scale, label="PROPELLR")]
+
+
 def full_propeller_iges_entities(model, blade, hub_sector, units: str = "m") -> list:
     """IGES records of the whole propeller: Z blades of five 128 each, and the whole hub as
     one 144 over a 120 turned a full turn, whose outer boundary is the boundary of its
@@ -237,10 +312,14 @@ def full_propeller_iges_entities(model, blade, hub_sector, units: str = "m") -> 
 
 
 def write_full_propeller_iges(path, model, blade, hub_sector, units: str = "m", *, resolution: float | None = None,
-                              **options) -> str:
-    """Write the whole propeller (:func:`full_propeller_iges_entities`) to ``path``
-    atomically. Returns the path."""
-    records = full_propeller_iges_entities(model, blade, hub_sector, units)
+                              brep: bool = False, **options) -> str:
+    """Write the whole propeller (:func:`full_propeller_iges_entities`, or with ``brep=True``
+    the 186 solid of :func:`full_propeller_brep_entities`) to ``path`` atomically. Returns
+    the path."""
+    if brep:
+        records = full_propeller_brep_entities(model, blade, hub_sector, units)
+    else:
+        records = full_propeller_iges_entities(model, blade, hub_sector, units)
     if resolution is None:
         resolution = DEFAULT_RESOLUTION / METRES_PER_UNIT[units.lower()]
     return write_iges(os.fspath(path), records, units=units, resolution=resolution, **options)
