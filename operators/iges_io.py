@@ -87,10 +87,11 @@ def _propeller_records(root, units: str, full_propeller: bool = False) -> list:
     """Hally §11 records of a smoothed propeller: the reference blade's five surfaces (from
     their stored float64 data) and the hub sector of the model the root's definition makes,
     trimmed by the blade root edge itself. ``full_propeller``: all Z blades and the whole
-    hub instead (:func:`..iges.propeller.full_propeller_iges_entities`), one closed shell."""
+    hub instead (:func:`..iges.propeller.full_propeller_iges_entities`), one closed shell;
+    ``"SOLID"``: the same faces as one IGES 186 manifold solid B-rep."""
     from ..geometry.propeller.hub_sector import hub_sector
     from ..geometry.propeller.smoothing import SURFACE_NAMES
-    from ..iges.propeller import full_propeller_iges_entities, propeller_iges_entities
+    from ..iges.propeller import full_propeller_brep_entities, full_propeller_iges_entities, propeller_iges_entities
     from . import propeller
 
     settings = root.bladesmith_propeller
@@ -108,6 +109,8 @@ def _propeller_records(root, units: str, full_propeller: bool = False) -> list:
         surfaces[name] = surface
     tolerance = propeller.smoothing_settings(propeller.smoothing_values(settings), model.definition.diameter)["tolerance"]
     sector = hub_sector(model, tolerance=tolerance, blade=surfaces)
+    if full_propeller == "SOLID":
+        return full_propeller_brep_entities(model, surfaces, sector, units.lower()), sector.warnings
     if full_propeller:
         return full_propeller_iges_entities(model, surfaces, sector, units.lower()), sector.warnings
     return propeller_iges_entities(model, surfaces, sector, units.lower()), sector.warnings
@@ -118,7 +121,8 @@ def export_objects(objects, filepath: str, units: str = "M", progress=None, full
     ``warnings``, a list of messages with figures).
 
     full_propeller: smoothed propellers go out whole (Z blades and the whole hub, one closed
-    shell) instead of as Hally's reference blade and hub sector.
+    shell) instead of as Hally's reference blade and hub sector; "SOLID": as one IGES 186
+    manifold solid B-rep.
 
     Raises :class:`BladesmithError` (nothing is written then) when an object cannot be
     expressed exactly or the data is inconsistent.
@@ -133,7 +137,8 @@ def export_objects(objects, filepath: str, units: str = "M", progress=None, full
         counts["warnings"] += [f"propeller '{root.name}': {w}" for w in warnings]
         records.extend(found)
         counts["propellers"] += 1
-        counts["surfaces"] += len(found) - 1
+        faces = found[0].shell.faces if full_propeller == "SOLID" else found
+        counts["surfaces"] += len(faces) - 1
         counts["trimmed"] += 1
     objects = [o for o in objects if o.type in EXPORTABLE_TYPES and propeller.find_root(o) not in roots]
     for i, obj in enumerate(objects):
@@ -249,6 +254,12 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
                     "closed shell (otherwise Hally's reference blade and hub sector)",
         default=False,
     )
+    brep_solid: BoolProperty(
+        name="As Solid (186)",
+        description="With Full Propeller: write the faces as one IGES 186 manifold solid B-rep "
+                    "(vertices, edges, loops, faces, shell) instead of loose faces",
+        default=False,
+    )
 
     def execute(self, context):
         objects = context.selected_objects if self.use_selection else context.scene.objects
@@ -256,7 +267,8 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
         wm.progress_begin(0, 100)
         try:
             counts = export_objects(objects, self.filepath, self.units, progress_callback(wm),
-                                    full_propeller=self.full_propeller)
+                                    full_propeller="SOLID" if self.full_propeller and self.brep_solid
+                                    else self.full_propeller)
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
@@ -264,7 +276,8 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
             wm.progress_end()
         message = f"Wrote {counts['surfaces']} surfaces, {counts['trimmed']} trimmed surfaces and {counts['curves']} curves"
         if counts["propellers"] and self.full_propeller:
-            message += f" ({counts['propellers']} smoothed propeller(s) whole: all blades and the whole hub)"
+            message += f" ({counts['propellers']} smoothed propeller(s) whole: all blades and the whole hub"
+            message += ", as one 186 solid)" if self.brep_solid else ")"
         elif counts["propellers"]:
             message += (
                 f" ({counts['propellers']} smoothed propeller(s) as reference blade and trimmed hub sector, "

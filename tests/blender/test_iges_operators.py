@@ -247,6 +247,12 @@ def test_full_propeller_option_writes_all_blades_and_the_whole_hub(scene, tmp_pa
         sewing.Add(face)
     sewing.Perform()
     assert len(r.faces) == 16 and sewing.NbFreeEdges() == 0
+    # and as one 186 solid
+    solid_path = tmp_path / "solid.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(solid_path), full_propeller=True, brep_solid=True) == {"FINISHED"}
+    r = occ.read_with_occ(solid_path)
+    assert r.load_messages == [] and r.transfer_messages == [] and len(r.faces) == 16
+    assert occ.is_valid(r.shape) and r.shape.ShapeType().name == "TopAbs_SOLID"
 
 
 def _occ_support():
