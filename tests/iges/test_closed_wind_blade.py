@@ -81,5 +81,10 @@ def test_cap_edges_are_the_halves_end_rows():
         gap = min(max(np.abs(edges[0] - ref_up).max(), np.abs(edges[1] - ref_lo).max()),
                   max(np.abs(edges[1] - ref_up).max(), np.abs(edges[0] - ref_lo).max()))
         assert gap <= 1e-12 * float(np.ptp(ref_up, axis=0).max())
+        # outward normal: away from the blade's mid-span point
+        D = cap.derivatives(0.5, 0.5, 1)
+        normal = np.cross(D[1, 0], D[0, 1])
+        mid = 0.5 * (molds.upper.evaluate(0.5, 0.5) + molds.lower.evaluate(0.5, 0.5))
+        assert float(normal @ (cap.evaluate(0.5, 0.5) - mid)) > 0
     with pytest.raises(GeometryError, match="not planar"):
         blade_caps(molds, "planar")
