@@ -126,6 +126,12 @@ def ruled_cap(upper: BSplineSurface, lower: BSplineSurface, v_end: bool, inward)
 
     a, b = make_compatible([_row(upper, v_end), reverse(_row(lower, v_end))])
     net = np.stack([a.control_points, b.control_points], axis=1)
+    # a sharp trailing edge: the halves' TE points agree to SHARP_TE_TOL, not bit for bit;
+    # make the cap's short edge there an exact point (a degenerate edge, not a 1e-17 m one)
+    size = float(np.ptp(net.reshape(-1, 3), axis=0).max())
+    for i in (0, -1):
+        if float(np.linalg.norm(net[i, 0] - net[i, 1])) <= CHAIN_TOL * size:
+            net[i, 1] = net[i, 0]
     W = None if a.weights is None else np.stack([a.weights, b.weights], axis=1)
     cap = BSplineSurface(a.degree, 1, a.knots, np.array([0.0, 0.0, 1.0, 1.0]), net, W)
     D = cap.derivatives(0.5, 0.5, 1) if hasattr(cap, "derivatives") else None
