@@ -31,3 +31,39 @@ def mold_records(molds: BladeMolds, parting_lines: bool = True, units: str = "m"
 def write_molds(path, molds: BladeMolds, units: str = "m", parting_lines: bool = True) -> str:
     """Write the molds to an IGES file atomically, coordinates in ``units``; returns the path."""
     return write_iges(path, mold_records(molds, parting_lines, units), units=units)
+
+
+def cap_record(cap, scale: float, label: str):
+    """A planar cap (:func:`~bladesmith.geometry.mold.caps.planar_cap`) as a 144 over its
+    plane (a bilinear 128), trimmed by one 142 whose 3-D curve is the composite of the mold
+    surfaces' end rows themselves (PREF = 2: the curve the cap shares with the surfaces) and
+    whose parameter curve is the composite of their exact (u, v) images."""
+    from .records import CompositeCurve, CurveOnSurface, TrimmedSurface
+
+    plane = surface_from_geometry(cap.plane, scale=scale, label=label)
+    loop = CurveOnSurface(surface=plane,
+                          parameter_curve=CompositeCurve(curves=[curve_from_geometry(c) for c in cap.pcurves]),
+                          model_curve=CompositeCurve(curves=[curve_from_geometry(c, scale=scale) for c in cap.edges]),
+                          creation=0, preferred=2)
+    return TrimmedSurface(surface=plane, outer=loop, inner=(), label=label)
+
+
+def closed_blade_records(molds: BladeMolds, units: str = "m", caps: str = "ruled") -> list:
+    """The mold surfaces plus root and tip caps (:func:`~bladesmith.geometry.mold.caps.blade_caps`):
+    faces that sew into one closed shell. caps: "ruled" (a 128 between the halves' end
+    rows, any section) or "planar" (a trimmed plane whose loop is the end rows themselves;
+    only where the end section is planar)."""
+    from ..geometry.mold.caps import blade_caps
+
+    scale = 1.0 / METRES_PER_UNIT[units.lower()]
+    root, tip = blade_caps(molds, caps)
+    out = mold_records(molds, parting_lines=False, units=units)
+    if caps == "planar":
+        return out + [cap_record(root, scale, "ROOTCAP"), cap_record(tip, scale, "TIPCAP")]
+    return out + [surface_from_geometry(root, scale=scale, label="ROOTCAP"),
+                  surface_from_geometry(tip, scale=scale, label="TIPCAP")]
+
+
+def write_closed_blade(path, molds: BladeMolds, units: str = "m", caps: str = "ruled") -> str:
+    """Write the closed blade (:func:`closed_blade_records`) atomically; returns the path."""
+    return write_iges(path, closed_blade_records(molds, units, caps), units=units)

@@ -52,6 +52,8 @@ HUB_LABEL = "HUB"
 #: A blade surface's boundary is "on the hub" when it comes this close to it, as a fraction
 #: of the diameter (only used to refuse blade surfaces that do not belong to this hub).
 ROOT_CHECK_FRACTION = 1e-2
+#: Samples per direction of each blade surface for that check.
+RANGE_CHECK_SAMPLES = 41
 
 
 def surface_continuity(surface: BSplineSurface) -> int:
@@ -115,19 +117,39 @@ def _check_consistency(model, blade_items, sector) -> None:
     R_hub = float(model.hub.radius)
     reach = ROOT_CHECK_FRACTION * D
     for label, s in blade_items:
-        r = np.hypot(s.control_points[..., 0], s.control_points[..., 1])
+        # the surface itself, not its control net: a finite tip chord is closed by a tip
+        # surface whose control points reach beyond R while the surface stays inside
+        # (Propeller definition: MAX_TIP_CHORD_RATIO)
+        (u0, u1), (v0, v1) = s.domain_u, s.domain_v
+        X = s.evaluate(np.linspace(u0, u1, RANGE_CHECK_SAMPLES)[:, None], np.linspace(v0, v1, RANGE_CHECK_SAMPLES)[None, :])
+        r = np.hypot(X[..., 0], X[..., 1])
         if r.max() < R_hub - reach or r.max() > 0.5 * D * (1.0 + ROOT_CHECK_FRACTION):
             raise GeometryError(f"blade surface {label} does not lie between the hub (r = {R_hub:.6g} m) "
                                 f"and the tip (r = {0.5 * D:.6g} m) of this propeller")
 
 
-def hub_records(sector, *, scale: float = 1.0, model_curves: bool = False) -> TrimmedSurface:
-    """The hub sector as a 144 over a 120 (see the module docstring); 3-D coordinates times
-    ``scale`` (file units per metre); parameter-space curves are in (ξ_h, θ) as they are."""
+def _hub_surface(sector, angle_range, scale: float) -> SurfaceOfRevolution:
     axis = Line(start=[0.0, 0.0, 0.0], end=[0.0, 0.0, -1.0])
     spine = curve_from_geometry(sector.generatrix, scale=scale, label="SPINE")
-    a0, a1 = map(float, sector.angle_range)
-    surface = SurfaceOfRevolution(axis=axis, generatrix=spine, start_angle=a0, end_angle=a1)
+    a0, a1 = map(float, angle_range)
+    return SurfaceOfRevolution(axis=axis, generatrix=spine, start_angle=a0, end_angle=a1)
+
+
+def _root_loop(surface, pcurves, edges, scale: float) -> CurveOnSurface:
+    """A 142 along a blade root: B = the composite of the root's images in (s, θ), C = the
+    composite of the root edges themselves (the blade surfaces' v = 0 rows, as 126 with the
+    same control points), PREF = 2: C is the curve both faces share."""
+    param = CompositeCurve(curves=[curve_from_geometry(c) for c in pcurves])
+    model = CompositeCurve(curves=[curve_from_geometry(c, scale=scale) for c in edges])
+    return CurveOnSurface(surface=surface, parameter_curve=param, model_curve=model, creation=2, preferred=2)
+
+
+def hub_records(sector, *, scale: float = 1.0, model_curves: bool = False) -> TrimmedSurface:
+    """The hub sector as a 144 over a 120 (see the module docstring); 3-D coordinates times
+    ``scale`` (file units per metre); parameter-space curves are in (ξ_h, θ) as they are.
+    A sector built from the blade (``hub_sector(..., blade=...)``) is trimmed by the blade
+    root edge itself (:func:`_root_loop`)."""
+    surface = _hub_surface(sector, sector.angle_range, scale)
 
     pieces = []
     for c in sector.outer_loop:
@@ -146,9 +168,161 @@ def hub_records(sector, *, scale: float = 1.0, model_curves: bool = False) -> Tr
         pref = 3
     outer = CurveOnSurface(surface=surface, parameter_curve=outer_param, model_curve=outer_model,
                            creation=0, preferred=pref)
-    inner = CurveOnSurface(surface=surface, parameter_curve=inner_param, model_curve=inner_model,
-                           creation=2, preferred=pref)
+    if sector.root_edges is not None:
+        inner = _root_loop(surface, sector.inner_loop, sector.root_edges, scale)
+    else:
+        inner = CurveOnSurface(surface=surface, parameter_curve=inner_param, model_curve=inner_model,
+                               creation=2, preferred=pref)
     return TrimmedSurface(surface=surface, outer=outer, inner=(inner,), label=HUB_LABEL)
+
+
+def turned_blade(items, rotation) -> list:
+    """(label, surface) of a blade turned by the 3x3 ``rotation``: every control net times
+    the matrix once (B-splines are affinely invariant), so a turned surface's edge rows are
+    the turned rows of the reference surface, the same numbers wherever they are used."""
+    R = np.asarray(rotation, dtype=np.float64)
+    out = []
+    for label, s in items:
+        out.append((label, BSplineSurface(s.degree_u, s.degree_v, s.knots_u, s.knots_v,
+                                          s.control_points @ R.T, s.weights)))
+    return out
+
+
+def full_propeller_geometry(model, blade, sector):
+    """The whole propeller as plain geometry: (blades, holes, angle_range).
+
+    blades: Z lists of (label, surface), blade k the reference blade turned by 2πk/Z
+    (:meth:`PropellerModel.blade_rotation`). holes: Z pairs (pcurves, root edges) trimming
+    the whole hub, blade k's footprint the reference loop moved by 2πk/Z in θ and its 3-D
+    curves the root rows of turned blade k. angle_range: a full turn with the seam between
+    two blades (:func:`~bladesmith.geometry.propeller.hub_sector.full_hub_angle_range`).
+    The sector must have been built from ``blade`` (its inner loop is the root edge)."""
+    from ..geometry.propeller.hub_sector import full_hub_angle_range, oriented_root_edges, turned_pcurves
+
+    if sector.root_edges is None:
+        raise GeometryError("a full propeller needs the hub sector built from the blade surfaces "
+                            "(hub_sector(model, blade=...)), so the hub is trimmed by the blade root edge itself")
+    items = _blade_surfaces(blade)
+    _check_consistency(model, items, sector)
+    names = dict((label, name) for name, label in BLADE_SURFACES)
+    blades, holes = [], []
+    for k in range(model.blades):
+        turned = items if k == 0 else turned_blade(items, model.blade_rotation(k))
+        blades.append(turned)
+        by_name = {names[label]: surface for label, surface in turned if label in names}
+        holes.append((turned_pcurves(sector, k), oriented_root_edges(sector, by_name)))
+    return blades, holes, full_hub_angle_range(sector)
+
+
+def _iso_uses(surface: BSplineSurface) -> list:
+    """The boundary of an untrimmed surface as one loop of edge uses (3-D curve, 2-D curve,
+    isoparametric) counter-clockwise in (u, v): v = v0 forwards, u = u1 forwards, v = v1
+    backwards, u = u0 backwards. The 3-D curves are the control rows of the net (the
+    surface's own boundary curves, exactly); each 2-D curve is the straight line in (u, v)
+    with the 3-D curve's parameter (so both run together)."""
+    from ..geometry.nurbs import BSplineCurve, reverse
+
+    (u0, u1), (v0, v1) = surface.domain_u, surface.domain_v
+    P, W = surface.control_points, surface.weights
+    Ku, Kv, p, q = surface.knots_u, surface.knots_v, surface.degree_u, surface.degree_v
+
+    def row(deg, knots, pts, w):
+        return BSplineCurve(deg, knots, np.array(pts), None if w is None else np.array(w))
+
+    def line(a, b, t0, t1):
+        return BSplineCurve(1, np.array([t0, t0, t1, t1]), np.array([a, b], dtype=np.float64))
+
+    bottom = (row(p, Ku, P[:, 0], None if W is None else W[:, 0]), line((u0, v0), (u1, v0), u0, u1))
+    right = (row(q, Kv, P[-1, :], None if W is None else W[-1, :]), line((u1, v0), (u1, v1), v0, v1))
+    top = (row(p, Ku, P[:, -1], None if W is None else W[:, -1]), line((u0, v1), (u1, v1), u0, u1))
+    left = (row(q, Kv, P[0, :], None if W is None else W[0, :]), line((u0, v0), (u0, v1), v0, v1))
+    return [(bottom[0], bottom[1], True), (right[0], right[1], True),
+            (reverse(top[0]), reverse(top[1]), True), (reverse(left[0]), reverse(left[1]), True)]
+
+
+def _hub_outer_uses(sector, angle_range) -> list:
+    """The outer boundary of the full-turn hub in (s, θ), counter-clockwise: the seam (the
+    spine turned to the start angle, exact: same knots and weights, s its parameter) from
+    the upstream to the downstream pole, the downstream pole (a degenerate edge), the seam
+    again backwards at the end angle (the same edge), the upstream pole."""
+    from ..geometry.nurbs import BSplineCurve, reverse
+
+    a0, a1 = map(float, angle_range)
+    S = sector.spine
+    rho, z = S.control_points[:, 0], S.control_points[:, 1]
+    seam = BSplineCurve(S.degree, S.knots, np.column_stack([rho * np.sin(a0), rho * np.cos(a0), z]), S.weights)
+    s0, s1 = map(float, S.domain)
+
+    def line(a, b, t0=0.0, t1=1.0):
+        return BSplineCurve(1, np.array([t0, t0, t1, t1]), np.array([a, b], dtype=np.float64))
+
+    up, down = seam.control_points[0], seam.control_points[-1]
+    return [(seam, line((s0, a0), (s1, a0), s0, s1), True),
+            (down.copy(), line((s1, a0), (s1, a1)), True),
+            (reverse(seam), reverse(line((s0, a1), (s1, a1), s0, s1)), True),
+            (up.copy(), line((s0, a1), (s0, a0)), True)]
+
+
+def full_propeller_brep_entities(model, blade, hub_sector, units: str = "m") -> list:
+    """The whole propeller as ONE IGES 186 manifold solid B-rep (with 502/504/508/510/514,
+    :mod:`.brep`): the faces of :func:`full_propeller_iges_entities` (5Z untrimmed 128s
+    bounded by their own boundary curves, the full-turn 120 with the Z blade root edges as
+    its loops and its own boundary as the outer one), every edge written once and used by
+    two faces, all face normals pointing out of the propeller (blade S_u × S_v, hub
+    h_ξ × h_θ)."""
+    from .brep import FaceSpec, solid_from_faces
+
+    key = units.lower() if isinstance(units, str) else units
+    if key not in UNITS or key not in METRES_PER_UNIT:
+        raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}")
+    scale = 1.0 / METRES_PER_UNIT[key]
+    blades, holes, angle_range = full_propeller_geometry(model, blade, hub_sector)
+    faces = []
+    for k, turned in enumerate(blades):
+        for label, s in turned:
+            record = surface_from_geometry(s, scale=scale, label=f"{label[:6]}{k + 1:02d}"[-8:] if k else label)
+            faces.append(FaceSpec(surface=record, loops=[_iso_uses(s)], outer=True))
+    hub = _hub_surface(hub_sector, angle_range, scale)
+    loops = [_hub_outer_uses(hub_sector, angle_range)]
+    loops += [[(edge, pc, False) for pc, edge in zip(pcs, edges)] for pcs, edges in holes]
+    faces.append(FaceSpec(surface=hub, loops=loops, outer=True))
+    return [solid_from_faces(faces, scale=scale, label="PROPELLR")]
+
+
+def full_propeller_iges_entities(model, blade, hub_sector, units: str = "m") -> list:
+    """IGES records of the whole propeller: Z blades of five 128 each, and the whole hub as
+    one 144 over a 120 turned a full turn, whose outer boundary is the boundary of its
+    parameter domain (N1 = 0; the poles and the seam are the surface's own) and whose Z
+    inner loops are the blade root edges (:func:`_root_loop`). Every blade face and the hub
+    face share their junction curve, so the faces sew into one closed shell at any
+    tolerance; no sector edges are written. See :func:`full_propeller_geometry`."""
+    key = units.lower() if isinstance(units, str) else units
+    if key not in UNITS or key not in METRES_PER_UNIT:
+        raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}")
+    scale = 1.0 / METRES_PER_UNIT[key]
+    blades, holes, angle_range = full_propeller_geometry(model, blade, hub_sector)
+    records = []
+    for k, turned in enumerate(blades):
+        records += [surface_from_geometry(s, scale=scale, label=f"{label[:6]}{k + 1:02d}"[-8:] if k else label)
+                    for label, s in turned]
+    surface = _hub_surface(hub_sector, angle_range, scale)
+    inner = [_root_loop(surface, pc, edges, scale) for pc, edges in holes]
+    records.append(TrimmedSurface(surface=surface, outer=None, inner=inner, label=HUB_LABEL))
+    return records
+
+
+def write_full_propeller_iges(path, model, blade, hub_sector, units: str = "m", *, resolution: float | None = None,
+                              brep: bool = False, **options) -> str:
+    """Write the whole propeller (:func:`full_propeller_iges_entities`, or with ``brep=True``
+    the 186 solid of :func:`full_propeller_brep_entities`) to ``path`` atomically. Returns
+    the path."""
+    if brep:
+        records = full_propeller_brep_entities(model, blade, hub_sector, units)
+    else:
+        records = full_propeller_iges_entities(model, blade, hub_sector, units)
+    if resolution is None:
+        resolution = DEFAULT_RESOLUTION / METRES_PER_UNIT[units.lower()]
+    return write_iges(os.fspath(path), records, units=units, resolution=resolution, **options)
 
 
 def propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, model_curves: bool = False) -> list:

@@ -41,6 +41,7 @@ from .records import (
     TransformationMatrix,
     TrimmedSurface,
 )
+from .brep import BREP_TYPES, parameter_curves, parameter_tokens, validate_brep
 from .validate import curve_flags, surface_flags, validate_entity, validate_loop
 
 #: Arrays up to this length are written with Python's shortest round-trip repr; longer ones
@@ -150,6 +151,8 @@ def _parameter_space(order) -> set[int]:
     for e in order:
         if isinstance(e, CurveOnSurface) and e.parameter_curve is not None:
             mark(e.parameter_curve)
+        for c in parameter_curves(e):  # B-rep loops (508)
+            mark(c)
     return out
 
 
@@ -217,6 +220,8 @@ def _pd(entity: Entity, de: dict, resolution: float) -> str:
     elif isinstance(entity, SurfaceOfRevolution):
         parts = ["120", str(de[id(entity.axis)]), str(de[id(entity.generatrix)]),
                  format_real(entity.start_angle), format_real(entity.end_angle)]
+    elif isinstance(entity, BREP_TYPES):
+        parts = [str(t), *parameter_tokens(entity, de, _reals)]
     elif isinstance(entity, TransformationMatrix):
         M = np.concatenate([entity.rotation, entity.translation[:, None]], axis=1)
         parts = ["124", _reals(M)]
@@ -433,7 +438,10 @@ def to_string(entities, *, units: str = "m", resolution: float | None = None, he
             _check_text(e.label, f"{e.describe()}: label")
             if not -9_999_999 <= e.subscript <= 99_999_999:
                 raise IgesError(f"{e.describe()}: subscript {e.subscript} does not fit 8 columns")
-            validate_entity(e, res)
+            if isinstance(e, BREP_TYPES):
+                validate_brep(e)
+            else:
+                validate_entity(e, res)
         for e in order:
             if isinstance(e, TrimmedSurface):
                 for loop in ((e.outer,) if e.outer is not None else ()) + e.inner:

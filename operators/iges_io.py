@@ -12,8 +12,10 @@ are closed, or only C0 across a knot, are written in exact pieces
 A tip-smoothed propeller (any of its objects selected, or all) is written the way
 Hally (2013) §11 prescribes instead of object by object: the five surfaces of the
 reference blade as 128 and the hub sector trimmed by the blade footprint as a 144 over a
-120, in the propeller's own coordinates. Rotated copies of a blade are rotated copies of
-these surfaces, which a mesher makes itself.
+120, in the propeller's own coordinates, the hub trimmed by the blade root edge itself (the
+blade surfaces' root rows as the trimming loop's 3-D curves). With ``full_propeller=True``
+all Z blades and the whole hub (one trimmed full-turn 120 with Z root holes) are written,
+faces that sew into one closed shell.
 
 Import (:func:`import_file`) reads leniently through :mod:`..iges.importer`: exact NURBS
 objects at the file's units and placement, trimmed faces as meshes inside their loops
@@ -74,12 +76,15 @@ def _smoothed_propeller_roots(objects) -> list:
     return roots
 
 
-def _propeller_records(root, units: str) -> list:
+def _propeller_records(root, units: str, full_propeller: bool = False) -> list:
     """Hally §11 records of a smoothed propeller: the reference blade's five surfaces (from
-    their stored float64 data) and the hub sector of the model the root's definition makes."""
+    their stored float64 data) and the hub sector of the model the root's definition makes,
+    trimmed by the blade root edge itself. ``full_propeller``: all Z blades and the whole
+    hub instead (:func:`..iges.propeller.full_propeller_iges_entities`), one closed shell;
+    ``"SOLID"``: the same faces as one IGES 186 manifold solid B-rep."""
     from ..geometry.propeller.hub_sector import hub_sector
     from ..geometry.propeller.smoothing import SURFACE_NAMES
-    from ..iges.propeller import propeller_iges_entities
+    from ..iges.propeller import full_propeller_brep_entities, full_propeller_iges_entities, propeller_iges_entities
     from . import propeller
 
     settings = root.bladesmith_propeller
@@ -96,11 +101,21 @@ def _propeller_records(root, units: str) -> list:
         (surface,) = object_to_geometry(obj)
         surfaces[name] = surface
     tolerance = propeller.smoothing_settings(propeller.smoothing_values(settings), model.definition.diameter)["tolerance"]
-    return propeller_iges_entities(model, surfaces, hub_sector(model, tolerance=tolerance), units.lower())
+    sector = hub_sector(model, tolerance=tolerance, blade=surfaces)
+    if full_propeller == "SOLID":
+        return full_propeller_brep_entities(model, surfaces, sector, units.lower()), sector.warnings
+    if full_propeller:
+        return full_propeller_iges_entities(model, surfaces, sector, units.lower()), sector.warnings
+    return propeller_iges_entities(model, surfaces, sector, units.lower()), sector.warnings
 
 
-def export_objects(objects, filepath: str, units: str = "M", progress=None) -> dict:
-    """Write the NURBS of ``objects`` to ``filepath`` (atomically). Returns counts.
+def export_objects(objects, filepath: str, units: str = "M", progress=None, full_propeller: bool = False) -> dict:
+    """Write the NURBS of ``objects`` to ``filepath`` (atomically). Returns counts (and
+    ``warnings``, a list of messages with figures).
+
+    full_propeller: smoothed propellers go out whole (Z blades and the whole hub, one closed
+    shell) instead of as Hally's reference blade and hub sector; "SOLID": as one IGES 186
+    manifold solid B-rep.
 
     Raises :class:`BladesmithError` (nothing is written then) when an object cannot be
     expressed exactly or the data is inconsistent.
@@ -108,13 +123,15 @@ def export_objects(objects, filepath: str, units: str = "M", progress=None) -> d
     from . import propeller
 
     scale = 1.0 / METRES_PER_UNIT[units.lower()]
-    records, counts = [], {"surfaces": 0, "curves": 0, "objects": 0, "propellers": 0, "trimmed": 0}
+    records, counts = [], {"surfaces": 0, "curves": 0, "objects": 0, "propellers": 0, "trimmed": 0, "warnings": []}
     roots = _smoothed_propeller_roots(objects)
     for root in roots:
-        found = _propeller_records(root, units)
+        found, warnings = _propeller_records(root, units, full_propeller)
+        counts["warnings"] += [f"propeller '{root.name}': {w}" for w in warnings]
         records.extend(found)
         counts["propellers"] += 1
-        counts["surfaces"] += len(found) - 1
+        faces = found[0].shell.faces if full_propeller == "SOLID" else found
+        counts["surfaces"] += len(faces) - 1
         counts["trimmed"] += 1
     objects = [o for o in objects if (o.type in EXPORTABLE_TYPES or o.get(EXACT_KEY) is not None)
                and propeller.find_root(o) not in roots]
@@ -251,24 +268,43 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
     filter_glob: StringProperty(default="*.igs;*.iges", options={"HIDDEN"})
     use_selection: BoolProperty(name="Selected Only", description="Export the selected objects only", default=False)
     units: EnumProperty(name="Units", items=UNIT_ITEMS, default="M")
+    full_propeller: BoolProperty(
+        name="Full Propeller",
+        description="Write smoothed propellers whole: all blades and the whole hub, faces that sew into one "
+                    "closed shell (otherwise Hally's reference blade and hub sector)",
+        default=False,
+    )
+    brep_solid: BoolProperty(
+        name="As Solid (186)",
+        description="With Full Propeller: write the faces as one IGES 186 manifold solid B-rep "
+                    "(vertices, edges, loops, faces, shell) instead of loose faces",
+        default=False,
+    )
 
     def execute(self, context):
         objects = context.selected_objects if self.use_selection else context.scene.objects
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
-            counts = export_objects(objects, self.filepath, self.units, progress_callback(wm))
+            counts = export_objects(objects, self.filepath, self.units, progress_callback(wm),
+                                    full_propeller="SOLID" if self.full_propeller and self.brep_solid
+                                    else self.full_propeller)
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         finally:
             wm.progress_end()
         message = f"Wrote {counts['surfaces']} surfaces, {counts['trimmed']} trimmed surfaces and {counts['curves']} curves"
-        if counts["propellers"]:
+        if counts["propellers"] and self.full_propeller:
+            message += f" ({counts['propellers']} smoothed propeller(s) whole: all blades and the whole hub"
+            message += ", as one 186 solid)" if self.brep_solid else ")"
+        elif counts["propellers"]:
             message += (
                 f" ({counts['propellers']} smoothed propeller(s) as reference blade and trimmed hub sector, "
                 "Hally 2013 §11)"
             )
+        for warning in counts["warnings"]:
+            self.report({"WARNING"}, warning)
         self.report({"INFO"}, f"{message} to {self.filepath} ({self.units.lower()})")
         return {"FINISHED"}
 

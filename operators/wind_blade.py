@@ -560,17 +560,22 @@ class BLADESMITH_OT_wind_blade_station_remove(_OnRoot, bpy.types.Operator):
         return {"FINISHED"}
 
 
-def export_molds(settings, filepath: str, progress=None) -> str:
+def export_molds(settings, filepath: str, progress=None, caps: str = "NONE") -> str:
     """Write the shown molds (rebuilt from the last good definition, with the shown
     control-point count, so IGES comes from the float64 model) to ``filepath`` in metres:
     the surfaces as 128, the parting lines as 126; the single surface alone when the
-    halves are off."""
+    halves are off. caps "RULED" or "PLANAR": the closed blade instead, the mold surfaces
+    with root and tip caps (:func:`..iges.mold.write_closed_blade`)."""
     if not settings.definition_toml:
         raise DefinitionError("the wind blade has no generated geometry to export")
     base = pathlib.Path(bpy.path.abspath(settings.base_dir)) if settings.base_dir else None
     defn = blade_from_dict(tomllib.loads(settings.definition_toml), "", base)
     n = max(defn.control_points, settings.fitted_control_points)
     molds = compute_molds(defn, control_points=n, tolerance=0.0, fairness=False, progress=progress)
+    if caps != "NONE":
+        from ..iges.mold import write_closed_blade
+
+        return write_closed_blade(filepath, molds, units="m", caps=caps.lower())
     if settings.mold_halves:
         return write_molds(filepath, molds, units="m")
     return write_iges(filepath, [surface_from_geometry(molds.single, label="SINGLE")], units="m")
@@ -586,6 +591,15 @@ class BLADESMITH_OT_export_wind_blade_iges(_OnRoot, bpy.types.Operator):
     filepath: StringProperty(name="File Path", subtype="FILE_PATH")
     filter_glob: StringProperty(default="*.igs;*.iges", options={"HIDDEN"})
     check_existing: BoolProperty(default=True, options={"HIDDEN"})
+    caps: EnumProperty(
+        name="Caps",
+        description="Close the blade with root and tip caps (one closed shell for CFD or FE), or write the open "
+                    "mold halves",
+        items=[("NONE", "Mold halves (open)", "The mold surfaces and parting lines, open at root and tip"),
+               ("RULED", "Closed, ruled caps", "Caps ruled between the halves' end sections (any section)"),
+               ("PLANAR", "Closed, planar caps", "Trimmed planes over the end sections (only planar sections)")],
+        default="NONE",
+    )
 
     def invoke(self, context, event):
         if not self.filepath:
@@ -605,7 +619,7 @@ class BLADESMITH_OT_export_wind_blade_iges(_OnRoot, bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
-            export_molds(root.bladesmith_wind_blade, path, progress=progress_callback(wm))
+            export_molds(root.bladesmith_wind_blade, path, progress=progress_callback(wm), caps=self.caps)
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}

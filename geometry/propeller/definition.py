@@ -30,7 +30,8 @@ Format (every field is checked; messages name the file, the field and the value)
 
     [radial]                      # arrays of equal length, stations from root to tip (r/R = 1)
     r_R = [...]                   # r/R, strictly increasing, last = 1
-    c_D = [...]                   # chord / D (> 0; 0 allowed at the tip only)
+    c_D = [...]                   # chord / D (> 0; 0 allowed at the tip only; a finite tip
+                                  # chord at most MAX_TIP_CHORD_RATIO of the largest)
     P_D = [...]                   # pitch / D (> 0)
     skew_deg = [...]              # skew angle of the mid-chord point, degrees, positive = skew back
     rake_D = [...]                # generator-line rake / D, positive downstream (aft)
@@ -62,6 +63,11 @@ HANDS = ("right", "left")
 HUB_SHAPES = ("ellipse", "cone", "flat")
 #: Tolerance on the tip station r/R = 1.
 TIP_TOL = 1e-9
+#: A finite chord at r/R = 1 is closed by Hally's tip surface (2013 §§6–9), which then
+#: rounds the tip off inside r <= R (1 + TIP_CLOSURE_ALLOWANCE); measured on the presets it
+#: works up to ~0.35 of the largest chord and fails beyond, so tip chords above this
+#: fraction of the largest chord are refused when the definition is read.
+MAX_TIP_CHORD_RATIO = 0.3
 
 _TOP_KEYS = {"name", "blades", "diameter", "hub_diameter_ratio", "hand", "radial_table", "section", "hub", "radial"}
 _SECTION_KEYS = {"thickness", "meanline", "thickness_x_c", "thickness_t", "meanline_x_c", "meanline_f", "smooth_airfoil",
@@ -234,6 +240,12 @@ class Propeller:
             if v < 0 or (v == 0 and i != n - 1):
                 what = "negative" if v < 0 else "zero (only the tip chord may be zero)"
                 raise DefinitionError(f"entry {i} (r_R = {r[i]}) is {v}: chord is {what}", path=p, field="radial.c_D")
+        if c[-1] > MAX_TIP_CHORD_RATIO * c.max():
+            raise DefinitionError(
+                f"the tip chord (entry {n - 1}, r_R = 1) is {c[-1]}, {c[-1] / c.max():.3g} of the largest chord "
+                f"{c.max()}: the tip closure (Hally's tip surface rounding off a finite tip) supports at most "
+                f"{MAX_TIP_CHORD_RATIO} of it. Lower the tip chord to <= {MAX_TIP_CHORD_RATIO * c.max():.4g}, "
+                f"or extend the table with stations that taper the chord to 0 at r_R = 1", path=p, field="radial.c_D")
         for name in ("P_D", "t_c"):
             a = np.asarray(arrays[name])
             bad = np.nonzero(a <= 0)[0]

@@ -101,6 +101,18 @@ MAX_ARC_ANGLE = 0.5 * np.pi
 
 PAPER_ANGLE_RANGE = (-np.pi, np.pi)
 
+#: The blade surfaces whose v = 0 rows form the blade root edge (Hally 2013 Eqs. 2–5: c_1
+#: round the trailing edge, c_2 on the pressure side, c_3 round the leading edge, c_4 on
+#: the suction side; a right-hand blade chains them in this order, a left-hand one the
+#: other way round).
+ROOT_SURFACES = ("trailing_edge", "pressure_central", "leading_edge", "suction_central")
+#: The parameter-space image of the root edge is fitted to this fraction of D (3-D distance
+#: on the hub): far below the sewing tolerance of 1e-7 D a CFD user works with.
+ROOT_PCURVE_FRACTION = 1e-9
+#: A root edge farther than this (fraction of D) from the hub belongs to another hub:
+#: refused. Between the sector tolerance and this the sector carries a warning.
+ROOT_ON_HUB_REFUSAL_FRACTION = 1e-3
+
 
 # -- exact Hermite boundary --------------------------------------------------------------------
 def hermite_boundary(xi, theta, slopes) -> BSplineCurve:
@@ -355,6 +367,11 @@ class HubSector:
     approximating p_b(u) in (s, θ), oriented clockwise (the inner loop). footprint_deviation:
     largest 3-D distance between h(footprint(u)) and the exact intersection at the same u
     (m). tolerance: the footprint tolerance asked for (m). area: of the trimmed sector (m²).
+    root_pcurves, root_edges: when built from the blade (``hub_sector(..., blade=...)``), the
+    inner loop in (s, θ) and in 3-D (the blade root edge itself, see :func:`blade_root_edges`),
+    clockwise; root_reversed: whether they run against +ξ. root_hub_distance: largest
+    distance between the root edge and its image on the hub (m). warnings: missed tolerances,
+    with figures.
     """
 
     hub: object
@@ -381,10 +398,40 @@ class HubSector:
     tolerance: float
     area: float
     intersection: object = field(repr=False, default=None)
+    root_pcurves: tuple | None = None
+    root_edges: tuple | None = None
+    root_hub_distance: float | None = None
+    root_reversed: bool = False
+    warnings: tuple = ()
 
     @property
     def inner_loop(self) -> tuple:
-        return (self.footprint,)
+        """The inner trimming loop in (s, θ): the parameter-space images of the blade root
+        edges when the sector was built from the blade surfaces, else the footprint spline."""
+        return self.root_pcurves if self.root_pcurves is not None else (self.footprint,)
+
+    @property
+    def inner_model_curves(self) -> tuple | None:
+        """The inner loop in 3-D when built from the blade: the blade root edges themselves
+        (the surfaces' v = 0 control rows, copied; reversed where the loop runs against +ξ),
+        in the order and sense of :attr:`inner_loop`. None for the footprint spline."""
+        return self.root_edges
+
+    def edge_model_curves(self, tolerance: float | None = None) -> tuple:
+        """3-D curves of the sector's ±π/Z edges as (reverse(p_h3), reverse(p_h1)), the
+        order of :attr:`outer_loop`. The first is the second's points turned by -2π/Z
+        (reverse(p_h3)(u) = p_h1(u) - (0, 2π/Z), Eq. 56) and reversed, both from ONE fitted
+        array, so in Z turned copies the +π/Z edge of one copy and the -π/Z edge of the next
+        are the same control points up to the rounding of one rotation (no refit)."""
+        c1 = self.model_curve(self.p_h1, tolerance)
+        if c1 is None:
+            raise GeometryError("the hub sector's edge p_h1 has no extent in 3-D")
+        a = -2.0 * np.pi / self.blades
+        sn, cs = np.sin(a), np.cos(a)
+        # θ -> θ + a with (ρ sin θ, ρ cos θ, z): the rotation of :meth:`PropellerModel.blade_rotation`
+        M = np.array([[cs, sn, 0.0], [-sn, cs, 0.0], [0.0, 0.0, 1.0]])
+        c3r = c1.with_control_points(c1.control_points @ M.T)
+        return c3r, reverse(c1)
 
     @property
     def loops(self) -> tuple:
@@ -440,9 +487,14 @@ class HubSector:
                            initial_knots=inner)
 
     def model_loops(self, tolerance: float | None = None) -> tuple:
-        """(outer, inner) loops in 3-D: the model curves of :meth:`model_curve`, degenerate
-        ones (points) left out."""
-        out = tuple(c for c in (self.model_curve(k, tolerance) for k in self.outer_loop) if c is not None)
+        """(outer, inner) loops in 3-D. Outer: the ±π/Z edges of :meth:`edge_model_curves`
+        (the end lines p_h2, p_h4 lie on the poles, points, and are left out). Inner: the
+        blade root edges when the sector was built from the blade, else a fit of the
+        footprint spline on the hub (:meth:`model_curve`)."""
+        c3r, c1r = self.edge_model_curves(tolerance)
+        out = (c3r, c1r)  # p_h4 and p_h2 lie on the poles: points, left out
+        if self.root_edges is not None:
+            return out, tuple(self.root_edges)
         return out, (self.model_curve(self.footprint, tolerance),)
 
 
@@ -558,6 +610,119 @@ def _footprint_spline(intersection, hub, spine: BSplineCurve, tolerance: float):
     return curve, float(dev.max()), reversed_
 
 
+# -- the blade root edge as the inner loop ---------------------------------------------------------------
+def blade_root_edges(blade) -> tuple:
+    """The blade root edge: the v = 0 control rows of the four surfaces that reach the hub
+    (:data:`ROOT_SURFACES`), chained head to tail from the trailing edge, each as a 3-D cubic B-spline over the surface's u
+    knots: the very curves of the surfaces' boundaries (copies of the same float64 rows).
+    Raises GeometryError when they do not chain head to tail exactly (a blade whose
+    surfaces do not share their corners)."""
+    curves = []
+    for name in ROOT_SURFACES:
+        surface = getattr(blade, name, None) if not isinstance(blade, dict) else blade.get(name)
+        if surface is None:
+            raise GeometryError(f"the blade root edge needs the blade surface {name!r}")
+        curves.append(BSplineCurve(surface.degree_u, surface.knots_u, np.array(surface.control_points[:, 0]),
+                                   None if surface.weights is None else np.array(surface.weights[:, 0])))
+    # chain head to tail from the trailing edge (a left-hand blade runs the other way round)
+    order, left = [0], [1, 2, 3]
+    while left:
+        end = curves[order[-1]].control_points[-1]
+        nxt = [k for k in left if np.array_equal(curves[k].control_points[0], end)]
+        if not nxt:
+            gap = min(float(np.linalg.norm(curves[k].control_points[0] - end)) for k in left)
+            raise GeometryError(f"the root edge of the blade surface {ROOT_SURFACES[order[-1]]} meets no other "
+                                f"root edge (nearest gap {gap:.3g} m): the blade surfaces do not share their corners")
+        order.append(nxt[0])
+        left.remove(nxt[0])
+    if not np.array_equal(curves[order[-1]].control_points[-1], curves[0].control_points[0]):
+        raise GeometryError("the blade root edge does not close: the blade surfaces do not share their corners")
+    curves = [curves[k] for k in order]
+    return tuple(curves)
+
+
+def hub_parameters_of_points(spine: BSplineCurve, points) -> np.ndarray:
+    """(s, θ) of the hub point at the same axial position z and angle θ = atan2(x, y) as
+    ``points`` (shape + (3,) -> shape + (2,)). On the cylinder this is the closest hub
+    point; a blade root lies on the cylinder or on the curved ends (not on a flat end)."""
+    P = np.asarray(points, dtype=np.float64)
+    return np.stack([spine_parameter_of_z(spine, P[..., 2]), np.arctan2(P[..., 0], P[..., 1])], axis=-1)
+
+
+def root_pcurves(spine: BSplineCurve, roots, tolerance: float):
+    """The root edges' images in the hub parameter space: for each 3-D root curve r(u),
+    the 2-D cubic B-spline p(u) ≈ (s, θ)(r(u)) (:func:`hub_parameters_of_points`), by
+    adaptive knot insertion from the curve's own interior knots (Hally 2013 §9/§11,
+    :func:`approximate`) in coordinates scaled to metres (s |C'|max, θ ρmax), so that
+    ``tolerance`` is a distance on the hub. Returns (pcurves, largest 3-D distance between
+    r(u) and h(p(u)) over all curves at the same u): the distance of the root edge from the
+    hub plus the fit error."""
+    s_samples = np.linspace(*spine.domain, 257)
+    D = spine.derivatives(s_samples, 1)
+    scale = np.array([float(np.max(np.linalg.norm(D[:, 1, :], axis=-1))), float(np.max(D[:, 0, 0]))])
+    out, dist = [], 0.0
+    for r in roots:
+        def image(u, r=r):
+            return hub_parameters_of_points(spine, r.evaluate(u)) * scale
+
+        interior = np.unique(r.knots[r.degree + 1 : -r.degree - 1])
+        fit = approximate(image, tolerance, degree=3, domain=r.domain, initial_knots=interior)
+        p = fit.with_control_points(fit.control_points / scale)
+        U = np.unique(p.knots)
+        u = (U[:-1, None] + np.linspace(0.0, 1.0, DEVIATION_SAMPLES_PER_SPAN + 1)[None, :] * np.diff(U)[:, None]).ravel()
+        q = p.evaluate(u)
+        dist = max(dist, float(np.max(np.linalg.norm(revolve_points(spine, q[:, 0], q[:, 1]) - r.evaluate(u), axis=-1))))
+        out.append(p)
+    return tuple(out), dist
+
+
+def root_footprint_distance(sector, blade, samples: int = DEVIATION_SAMPLES_PER_SPAN) -> float:
+    """Largest 3-D distance between the sector's inner-loop model curves and the blade's
+    root edge (:func:`blade_root_edges`) at matching parameters; 0 when the loop is the root
+    edge itself. Raises GeometryError when the sector was not built from a blade."""
+    if sector.root_edges is None:
+        raise GeometryError("the hub sector was built from the blade–hub intersection, not from the blade root edge")
+    roots = oriented_root_edges(sector, blade)
+    loop = sector.root_edges
+    worst = 0.0
+    for a, b in zip(roots, loop):  # same order: both chained by blade_root_edges
+        U = np.unique(np.concatenate([a.knots, b.knots]))
+        u = (U[:-1, None] + np.linspace(0.0, 1.0, samples + 1)[None, :] * np.diff(U)[:, None]).ravel()
+        worst = max(worst, float(np.max(np.linalg.norm(a.evaluate(u) - b.evaluate(u), axis=-1))))
+    return worst
+
+
+def full_hub_angle_range(sector) -> tuple[float, float]:
+    """(a0, a0 + 2π): the angular range of a hub turned a full turn, with its seam midway
+    between the reference blade's root and the root of the blade before it, so the Z
+    footprints (the reference one turned by 2πk/Z, k = 0..Z-1) lie strictly inside.
+    Raises GeometryError when neighbouring roots overlap on the hub."""
+    lo, hi = _theta_extent(sector.inner_loop)  # conservative (control polygons)
+    pitch = 2.0 * np.pi / sector.blades
+    if not hi - lo < pitch:
+        raise GeometryError(f"the blade root spans {hi - lo:.6g} rad of the hub, more than the blade pitch "
+                            f"2π/Z = {pitch:.6g} rad: neighbouring blade roots overlap")
+    a0 = 0.5 * (lo + hi - pitch)
+    return a0, a0 + 2.0 * np.pi
+
+
+def turned_pcurves(sector, k: int) -> tuple:
+    """The inner loop of blade k's footprint in (s, θ): the reference loop moved by
+    (0, 2πk/Z) (the hub is axisymmetric, so this is exact)."""
+    d = 2.0 * np.pi * k / sector.blades
+    return tuple(c.with_control_points(c.control_points + np.array([0.0, d])) for c in sector.inner_loop)
+
+
+def oriented_root_edges(sector, blade) -> tuple:
+    """The root edge of ``blade`` (any turned copy of the blade the sector was built from)
+    chained and oriented as the sector's inner loop (:func:`blade_root_edges`, reversed when
+    the sector's is)."""
+    roots = blade_root_edges(blade)
+    if sector.root_reversed:
+        roots = tuple(reverse(c) for c in roots[::-1])
+    return roots
+
+
 # -- Eqs. 51-58 ----------------------------------------------------------------------------------------
 def _sector_curves(xi_lo, xi_hi, le, te, Z, clamp_range):
     """Eqs. 51–58 for the given clamp range: (m, θ_lo, θ_hi, p_h, p_h1, p_h2, p_h3, p_h4)."""
@@ -593,13 +758,21 @@ def _theta_extent(curves) -> tuple[float, float]:
     return float(th.min()), float(th.max())
 
 
-def hub_sector(model, tolerance: float | None = None, clamp_range=None, intersection=None) -> HubSector:
+def hub_sector(model, tolerance: float | None = None, clamp_range=None, intersection=None, blade=None) -> HubSector:
     """The trimmed hub sector of ``model`` (a :class:`~.model.PropellerModel`), Hally (2013) §10.
 
     tolerance: footprint tolerance in metres (default FOOTPRINT_TOLERANCE_FRACTION × D; use
     the blade surfaces' tolerance). clamp_range: [θ_min, θ_max] of Eqs. 51–52 (default
     [-π, π] as in the paper; when the sector does not fit it, it is centred on the sector).
     intersection: a :class:`BladeHubIntersection` (default the model's).
+    blade: the blade surfaces (a ``SmoothedBlade`` or a dict of the five). When given, the
+    inner loop is the blade root edge itself (:func:`blade_root_edges`): its model-space
+    curves are the surfaces' v = 0 rows (copied), its parameter-space curves their images on
+    the hub (:func:`root_pcurves`, fitted to ROOT_PCURVE_FRACTION × D), so blade and hub share
+    one junction curve (Hally 2013 §10: the blade–hub intersection, fillet-free) and sew
+    at any tolerance. ``root_hub_distance`` then says how far that curve lies from the
+    hub; above ``tolerance`` the sector carries a warning, above
+    ROOT_ON_HUB_REFUSAL_FRACTION × D it is refused.
     Raises :class:`GeometryError` when the sector cannot be built.
     """
     hub = model.hub
@@ -619,6 +792,26 @@ def hub_sector(model, tolerance: float | None = None, clamp_range=None, intersec
 
     footprint, deviation, reversed_ = _footprint_spline(I, hub, spine, tol)
     fp_lo, fp_hi = _theta_extent([footprint])
+    pcurves = roots = root_dist = None
+    root_reversed = False
+    warnings = []
+    if blade is not None:
+        roots = blade_root_edges(blade)
+        pcurves, root_dist = root_pcurves(spine, roots, ROOT_PCURVE_FRACTION * D)
+        if root_dist > ROOT_ON_HUB_REFUSAL_FRACTION * D:
+            raise GeometryError(f"the blade root edge lies {root_dist:.3g} m ({root_dist / D:.3g} D) from the hub: "
+                                f"these blade surfaces do not end on this propeller's hub")
+        if root_dist > tol:
+            warnings.append(f"the blade root edge lies up to {root_dist:.3g} m from the hub, more than the "
+                            f"footprint tolerance {tol:.3g} m")
+        # the inner loop runs clockwise in (s, θ), like the footprint spline
+        P = np.concatenate([c.evaluate(np.linspace(*c.domain, 257)) for c in pcurves])
+        x, y = P[:, 0], P[:, 1]
+        if 0.5 * float(np.sum(x[:-1] * y[1:] - x[1:] * y[:-1])) > 0.0:
+            pcurves = tuple(reverse(c) for c in pcurves[::-1])
+            roots = tuple(reverse(c) for c in roots[::-1])
+            root_reversed = True
+        fp_lo, fp_hi = _theta_extent(pcurves)
 
     requested = clamp_range is not None
     rng = tuple(map(float, PAPER_ANGLE_RANGE if clamp_range is None else clamp_range))
@@ -639,7 +832,7 @@ def hub_sector(model, tolerance: float | None = None, clamp_range=None, intersec
     angle_range = (max(rng[0], lo - ANGLE_MARGIN), min(rng[1], hi + ANGLE_MARGIN))
 
     outer = (reverse(p_h3), p_h4, reverse(p_h1), p_h2)
-    area = trimmed_area(spine, (outer, (footprint,)))
+    area = trimmed_area(spine, (outer, pcurves if pcurves is not None else (footprint,)))
     if not area > 0:
         raise GeometryError(f"the trimmed hub sector has non-positive area {area:.6g} m²: the footprint "
                             f"does not lie inside the sector")
@@ -648,4 +841,6 @@ def hub_sector(model, tolerance: float | None = None, clamp_range=None, intersec
         leading_edge=le, trailing_edge=te, slope=float(m), theta_lo=float(th_lo), theta_hi=float(th_hi),
         boundary=p_h, p_h1=p_h1, p_h2=p_h2, p_h3=p_h3, p_h4=p_h4, outer_loop=outer, footprint=footprint,
         footprint_reversed=reversed_, footprint_deviation=deviation, tolerance=tol, area=area, intersection=I,
+        root_pcurves=pcurves, root_edges=roots, root_hub_distance=root_dist, root_reversed=root_reversed,
+        warnings=tuple(warnings),
     )

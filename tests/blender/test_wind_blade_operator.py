@@ -299,6 +299,18 @@ def test_export_iges_writes_the_molds(root, tmp_path):
     assert len(read_iges(str(single_path)).of_type(BSplineSurface128)) == 1
 
 
+def test_export_iges_closed_blade_with_caps(root, tmp_path):
+    """caps='RULED': the mold surfaces plus a root and a tip cap, no parting lines."""
+    root.bladesmith_wind_blade.mold_halves = True
+    path = tmp_path / "closed.igs"
+    assert bpy.ops.bladesmith.export_wind_blade_iges(filepath=str(path), caps="RULED") == {"FINISHED"}
+    model = read_iges(str(path))
+    labels = {rec.label for rec in model.of_type(BSplineSurface128)}
+    assert {"UPPER", "LOWER", "ROOTCAP", "TIPCAP"} <= labels
+    assert model.of_type(BSplineCurve126) == [] or all(
+        rec.label not in ("LEPART",) for rec in model.of_type(BSplineCurve126))
+
+
 def test_blend_file_keeps_the_definition(root, tmp_path):
     s = root.bladesmith_wind_blade
     s.stations[6].twist_deg = 3.5

@@ -293,3 +293,96 @@ def test_c1_spine_keeps_creases_exact():
         s = spine.knots[-4]  # k2: the cylinder's downstream end
         assert np.allclose(spine.evaluate(s), J2, atol=1e-14)
         assert np.linalg.norm(spine.derivatives(s, 1)[1]) < 1e-6
+
+
+# -- the junction: the blade root edge itself as the inner loop -----------------------------------------
+_BLADES: dict = {}
+
+
+def sector_from_blade(name):
+    if name not in _BLADES:
+        from bladesmith.geometry.propeller import smooth_blade
+
+        model, _ = sector_of(name)
+        blade = smooth_blade(model, measure=False)
+        _BLADES[name] = (model, blade, hub_sector(model, blade=blade))
+    return _BLADES[name]
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_inner_loop_is_the_blade_root_edge_itself(name):
+    """The inner loop's 3-D curves are the four root rows of the blade surfaces, the same
+    float64 control points (reversed as a whole when the loop runs against +ξ); the root
+    footprint distance is 0 (<= 1e-12 D); the parameter-space loop maps onto them within
+    the root's distance from the hub, which is within the sector tolerance."""
+    from bladesmith.geometry.propeller.hub_sector import ROOT_SURFACES, blade_root_edges, root_footprint_distance
+
+    model, blade, sector = sector_from_blade(name)
+    D = 2.0 * model.blade.radius
+    rows = [getattr(blade, n).control_points[:, 0] for n in ROOT_SURFACES]
+    assert len(sector.root_edges) == 4
+    for c in sector.root_edges:
+        assert any(np.array_equal(c.control_points, r) or np.array_equal(c.control_points[::-1], r) for r in rows)
+    assert root_footprint_distance(sector, blade) <= 1e-12 * D
+    assert sector.root_hub_distance <= sector.tolerance and sector.warnings == ()
+    # chained head to tail, closed, clockwise in (s, θ) like the footprint spline
+    loop = sector.inner_loop
+    for a, b in zip(loop, loop[1:] + loop[:1]):
+        np.testing.assert_array_equal(sector.evaluate(*a.evaluate(a.domain[1])), sector.evaluate(*b.evaluate(b.domain[0])))
+    P = np.concatenate([c.evaluate(np.linspace(0, 1, 201)) for c in loop])
+    assert 0.5 * np.sum(P[:-1, 0] * P[1:, 1] - P[1:, 0] * P[:-1, 1]) < 0
+    # h(p(u)) follows the root edge at the same u
+    for p, r in zip(loop, sector.root_edges):
+        u = np.linspace(0, 1, 301)
+        q = p.evaluate(u)
+        assert np.linalg.norm(sector.evaluate(q[:, 0], q[:, 1]) - r.evaluate(u), axis=-1).max() <= sector.tolerance
+    # the same trimmed area as the sector trimmed by the exact intersection
+    _, plain = sector_of(name)
+    assert sector.area == pytest.approx(plain.area, rel=1e-6)
+    # and the curves are those of blade_root_edges (a copy, not a refit)
+    assert sum(c.n_control for c in blade_root_edges(blade)) == sum(c.n_control for c in sector.root_edges)
+
+
+def test_root_edges_that_do_not_meet_or_miss_the_hub_are_refused():
+    from bladesmith.geometry.nurbs import BSplineSurface
+
+    model, blade, _ = sector_from_blade("dtmb4119")
+    surfaces = {n: getattr(blade, n) for n in ("pressure_central", "suction_central", "leading_edge",
+                                               "trailing_edge", "tip")}
+    moved = dict(surfaces)
+    s = surfaces["leading_edge"]
+    moved["leading_edge"] = BSplineSurface(s.degree_u, s.degree_v, s.knots_u, s.knots_v,
+                                           s.control_points + np.array([0.0, 0.0, 1e-9]))
+    with pytest.raises(GeometryError, match="share their corners"):
+        hub_sector(model, blade=moved)
+    lifted = {n: BSplineSurface(t.degree_u, t.degree_v, t.knots_u, t.knots_v, t.control_points * 1.05)
+              for n, t in surfaces.items()}
+    with pytest.raises(GeometryError, match="from the hub"):
+        hub_sector(model, blade=lifted)
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_edges_of_neighbouring_copies_coincide(name):
+    """The -π/Z edge of copy k+1 (turned by 2π/Z) and the +π/Z edge of copy k are the same
+    control points up to the rounding of one rotation, and both lie on the hub."""
+    model, sector = sector_of(name)
+    D = 2.0 * model.blade.radius
+    c3r, c1r = sector.edge_model_curves()
+    turned = c3r.control_points @ model.blade_rotation(1).T
+    assert np.abs(turned - c1r.control_points[::-1]).max() <= 1e-15 * D
+    u = np.linspace(0.0, 1.0, 201)
+    # each follows its edge on the hub at the same parameter (outer loop order and sense)
+    for curve, edge in ((c3r, sector.outer_loop[0]), (c1r, sector.outer_loop[2])):
+        assert np.linalg.norm(curve.evaluate(u) - sector.model_points(edge, u), axis=-1).max() <= sector.tolerance
+
+
+def test_full_turn_range_holds_every_footprint():
+    from bladesmith.geometry.propeller.hub_sector import full_hub_angle_range, turned_pcurves
+
+    for name in PRESETS:
+        model, _, sector = sector_from_blade(name)
+        a0, a1 = full_hub_angle_range(sector)
+        assert a1 - a0 == pytest.approx(2 * np.pi, abs=1e-15)
+        for k in range(model.blades):
+            th = np.concatenate([c.control_points[:, 1] for c in turned_pcurves(sector, k)])
+            assert a0 < th.min() and th.max() < a1

@@ -101,6 +101,17 @@ def test_refuses_negative_chord(tmp_path):
     assert e.field == "radial.c_D"
 
 
+def test_finite_tip_chord_up_to_the_closure_limit_is_read_and_above_it_refused_with_the_fix(tmp_path):
+    from bladesmith.geometry.propeller.definition import MAX_TIP_CHORD_RATIO
+
+    c_max = 0.4622  # DTMB 4119's largest chord / D
+    ok = _edited(tmp_path, "0.2775,  0.0000]", f"0.2775,  {MAX_TIP_CHORD_RATIO * c_max:.6f}]")
+    assert Propeller.from_toml(ok).radial.c_D[-1] > 0
+    bad = _edited(tmp_path, "0.2775,  0.0000]", "0.2775,  0.2000]")
+    e = _refused(bad, "radial.c_D", "0.2", "tip chord", "Lower the tip chord")
+    assert e.field == "radial.c_D"
+
+
 def test_refuses_nan(tmp_path):
     path = _edited(tmp_path, "1.093,   1.088", "nan,   1.088")
     _refused(path, "radial.P_D", "nan")
