@@ -29,13 +29,17 @@ from .blade_surfaces import (
     fit_rows,
 )
 from .corners import DefiningPoints, blade_derivatives, blade_points, check_corner_order, corner_points
-from .cut_smoothing import MAX_STABLE_FILTER_STRENGTH, curvature_sign_changes, spline_signed_curvature
+from .cut_smoothing import (
+    MAX_STABLE_FILTER_STRENGTH,
+    SMOOTHING_ZONE_BOUND,
+    curvature_sign_changes,
+    spline_signed_curvature,
+)
 from .edge_curves import EdgeCurveSet, build_edge_curves
+from .irregularity import tip_irregularity
 from .side_curves import side_curves
 
 SURFACE_NAMES = ("pressure_central", "suction_central", "leading_edge", "trailing_edge", "tip")
-#: Documented bound on the deviation inside the smoothing zone, as a fraction of R.
-SMOOTHING_ZONE_BOUND = 5e-3
 #: Fraction of a tip-surface edge at each end left out of the normal-angle check: the
 #: tip surface meets c_9/c_12 (and c_10/c_12, c_9/c_11, c_10/c_11) at corners where its
 #: boundary curves continue each other (corner angle ~180°), so S_u and S_v are nearly
@@ -61,7 +65,8 @@ class SmoothingSettings:
         half-way down the leading edge, Hally's advice).
     filter_strength: α of Eq. 30 (0 < α <= 0.75, the stability limit of Eq. 29).
         Default 0.5.
-    filter_iterations: n of Eq. 29. Default 50.
+    filter_iterations: n of Eq. 29. Default 100 (the filter works in arclength and
+        is guarded, see :func:`~.cut_smoothing.smooth_cut`).
     tolerance: the accuracy of the spline curves (§9). Default 2e-5 (= 1e-5 D).
     sample_spacing: d of Eqs. 27–28, the largest spacing of the cut samples (§7).
         Default 0.01.
@@ -74,7 +79,7 @@ class SmoothingSettings:
     edge_smoothing_distance: float = 0.05
     transition_s: float = 0.75
     filter_strength: float = 0.5
-    filter_iterations: int = 50
+    filter_iterations: int = 100
     tolerance: float = 2e-5
     sample_spacing: float = 0.01
     edge_spacing_ratio: float = 0.01
@@ -422,6 +427,7 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
         "max_smoothing_displacement_m": max([s.max_displacement for s in curves.smoothing.values()], default=0.0),
         "times_s": times,
     }
+    report["tip_irregularity"] = tip_irregularity(blade, curves, settings.edge_smoothing_distance * R)
     lap("report")
     if measure:
         dev = deviation_report(blade, surfaces, params, curves)
