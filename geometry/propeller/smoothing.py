@@ -47,6 +47,17 @@ SURFACE_NAMES = ("pressure_central", "suction_central", "leading_edge", "trailin
 TIP_CORNER_EXCLUSION = 0.02
 #: Newton iterations of the closest-point projection onto b.
 PROJECTION_ITERATIONS = 12
+#: Samples per direction of each surface in the deviation report, and Newton iterations.
+DEVIATION_SAMPLES = 31
+DEVIATION_ITERATIONS = 25
+#: Refinement of the deviation maxima: the worst samples, and points per direction.
+DEVIATION_WORST = 6
+DEVIATION_REFINE = 9
+#: Seed grid on b for projecting the tip surface (ξ by w = sqrt(1 - η)), from this far
+#: below the lowest η of the tip cuts.
+SEED_XI = 480
+SEED_W = 120
+SEED_ETA_MARGIN = 0.02
 
 
 @dataclass(frozen=True)
@@ -274,33 +285,92 @@ def _zone_mask(smoothed: np.ndarray, coord: np.ndarray) -> np.ndarray:
     return (k >= idx.min() - 1) & (k <= idx.max() + 1)
 
 
-def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curves: EdgeCurveSet, samples: int = 41):
+class BladeSeeds:
+    """Nearest points of a grid on b above η_low (ξ uniform, η = 1 - w² with w uniform,
+    so the grid closes on the tip like the blade does), for starting projections: a
+    KD-tree over n_xi × n_w points."""
+
+    def __init__(self, blade, eta_low: float, n_xi: int = None, n_w: int = None):
+        from scipy.spatial import cKDTree
+
+        n_xi = SEED_XI if n_xi is None else n_xi
+        n_w = SEED_W if n_w is None else n_w
+        xi = np.arange(n_xi) / n_xi
+        w = np.linspace(0.0, np.sqrt(1.0 - max(eta_low, blade.eta_min)), n_w)
+        XI, W = np.meshgrid(xi, w, indexing="ij")
+        self.params = np.stack([XI.ravel(), 1.0 - W.ravel() ** 2], axis=1)
+        self.tree = cKDTree(blade.evaluate(self.params[:, 0], self.params[:, 1]))
+
+    def nearest(self, X) -> np.ndarray:
+        _, idx = self.tree.query(np.asarray(X, dtype=np.float64))
+        return self.params[idx]
+
+
+def _project(blade, X, starts):
+    """Shortest closest-point distance over several start parameter sets."""
+    best_d, best_p = None, None
+    for P in starts:
+        d, p = project_to_blade(blade, X, P, iterations=DEVIATION_ITERATIONS)
+        if best_d is None:
+            best_d, best_p = d, p
+        else:
+            take = d < best_d
+            best_d, best_p = np.where(take, d, best_d), np.where(take[:, None], p, best_p)
+    return best_d, best_p
+
+
+def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curves: EdgeCurveSet,
+                     samples: int = DEVIATION_SAMPLES):
     """Closest-point distance from the surfaces to the unsmoothed blade, split into the
-    smoothing zone and the rest (metres): dict per surface and overall maxima."""
+    smoothing zone and the rest (metres): dict per surface and overall maxima.
+
+    Samples: a ``samples``² grid of each surface, then a finer grid (DEVIATION_REFINE²
+    points over one cell each way) around the DEVIATION_WORST largest samples inside and
+    outside the zone, so the maxima are the surface's and not the coarse grid's. Starts:
+    the companion parameters; on the tip (which has none, its parameters jump between ξ
+    branches across the tip), the nearest cut and the nearest point of a grid on b
+    (:class:`BladeSeeds`), keeping the shorter distance: from the cut alone the
+    projection can end in a far local minimum where the parameter lines crowd."""
     t = np.linspace(0.0, 1.0, samples)
     U, V = np.meshgrid(t, t, indexing="ij")
     u, v = U.ravel(), V.ravel()
     zone_coord = {"leading_edge": (curves.smoothed_leading, v), "trailing_edge": (curves.smoothed_trailing, v),
                   "tip": (curves.smoothed_tip, u)}
+    seeds = None
+    step = 1.0 / (samples - 1)
+    local = np.linspace(-step, step, DEVIATION_REFINE)
     out = {}
     for name, S in smoothed_surfaces.items():
         X = S.evaluate(u, v)
         if name == "tip":
-            # the tip's parameters jump between ξ branches across the tip (no continuous
-            # companion): start from the nearest tip cut instead
             k = np.rint(u * (len(curves.tip) - 1)).astype(int)
             P = np.empty((u.size, 2))
             for kk in np.unique(k):
                 P[k == kk] = curves.tip[kk].parameters(v[k == kk])
+            if seeds is None:
+                seeds = BladeSeeds(blade, float(P[:, 1].min()) - SEED_ETA_MARGIN)
+            d, p = _project(blade, X, [P, seeds.nearest(X)])
         else:
-            P = param_surfaces[name].evaluate(u, v)
-        d, _ = project_to_blade(blade, X, P)
+            d, p = _project(blade, X, [param_surfaces[name].evaluate(u, v)])
         if name in zone_coord:
             zone = _zone_mask(*zone_coord[name])
         else:
             zone = np.zeros(d.shape, dtype=bool)
-        out[name] = {"outside": float(d[~zone].max()) if np.any(~zone) else 0.0,
-                     "inside": float(d[zone].max()) if np.any(zone) else 0.0}
+        res = {}
+        for key, mask in (("outside", ~zone), ("inside", zone)):
+            if not np.any(mask):
+                res[key] = 0.0
+                continue
+            idx = np.flatnonzero(mask)
+            top = idx[np.argsort(d[idx])[-DEVIATION_WORST:]]
+            du, dv = np.meshgrid(local, local, indexing="ij")
+            uu = np.clip(u[top, None] + du.ravel()[None], 0.0, 1.0).ravel()
+            vv = np.clip(v[top, None] + dv.ravel()[None], 0.0, 1.0).ravel()
+            Xr = S.evaluate(uu, vv)
+            other = seeds.nearest(Xr) if name == "tip" else param_surfaces[name].evaluate(uu, vv)
+            dr, _ = _project(blade, Xr, [np.repeat(p[top], du.size, axis=0), other])
+            res[key] = float(max(d[idx].max(), dr.max()))
+        out[name] = res
     out["max_outside"] = max(v["outside"] for v in out.values() if isinstance(v, dict))
     out["max_inside"] = max(v["inside"] for v in out.values() if isinstance(v, dict))
     return out
