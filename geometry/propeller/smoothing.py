@@ -497,6 +497,8 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
         "max_smoothing_displacement_m": max([s.max_displacement for s in curves.smoothing.values()], default=0.0),
         "times_s": times,
     }
+    # the guard of §7 (cut_smoothing.smooth_cut): cuts where fewer sweeps were kept, and why
+    report["smoothing_stops"] = [sm.stopped for sm in curves.smoothing.values() if sm.stopped]
     report["tip_irregularity"] = tip_irregularity(blade, curves, settings.edge_smoothing_distance * R)
     lap("report")
     if measure:
