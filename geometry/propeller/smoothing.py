@@ -52,6 +52,8 @@ DEVIATION_SAMPLES = 31
 DEVIATION_ITERATIONS = 25
 #: Refinement of the deviation maxima: the worst samples, and points per direction.
 DEVIATION_WORST = 6
+#: Samples of the tip surface per interval between its cuts, across them.
+DEVIATION_TIP_PER_CUT = 4
 DEVIATION_REFINE = 9
 #: Seed grid on b for projecting the tip surface (ξ by w = sqrt(1 - η)), from this far
 #: below the lowest η of the tip cuts.
@@ -332,15 +334,18 @@ def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curve
     (:class:`BladeSeeds`), keeping the shorter distance: from the cut alone the
     projection can end in a far local minimum where the parameter lines crowd."""
     t = np.linspace(0.0, 1.0, samples)
-    U, V = np.meshgrid(t, t, indexing="ij")
-    u, v = U.ravel(), V.ravel()
-    zone_coord = {"leading_edge": (curves.smoothed_leading, v), "trailing_edge": (curves.smoothed_trailing, v),
-                  "tip": (curves.smoothed_tip, u)}
     seeds = None
-    step = 1.0 / (samples - 1)
-    local = np.linspace(-step, step, DEVIATION_REFINE)
     out = {}
     for name, S in smoothed_surfaces.items():
+        # the tip surface across its cuts: DEVIATION_TIP_PER_CUT samples per interval (the
+        # surface is exact on the cuts; it departs from b between them)
+        tu = np.linspace(0.0, 1.0, DEVIATION_TIP_PER_CUT * (len(curves.tip) - 1) + 1) if name == "tip" else t
+        U, V = np.meshgrid(tu, t, indexing="ij")
+        u, v = U.ravel(), V.ravel()
+        zone_coord = {"leading_edge": (curves.smoothed_leading, v), "trailing_edge": (curves.smoothed_trailing, v),
+                      "tip": (curves.smoothed_tip, u)}
+        local = np.stack(np.meshgrid(np.linspace(-1, 1, DEVIATION_REFINE) / (tu.size - 1),
+                                     np.linspace(-1, 1, DEVIATION_REFINE) / (samples - 1), indexing="ij"))
         X = S.evaluate(u, v)
         if name == "tip":
             k = np.rint(u * (len(curves.tip) - 1)).astype(int)
@@ -363,7 +368,7 @@ def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curve
                 continue
             idx = np.flatnonzero(mask)
             top = idx[np.argsort(d[idx])[-DEVIATION_WORST:]]
-            du, dv = np.meshgrid(local, local, indexing="ij")
+            du, dv = local
             uu = np.clip(u[top, None] + du.ravel()[None], 0.0, 1.0).ravel()
             vv = np.clip(v[top, None] + dv.ravel()[None], 0.0, 1.0).ravel()
             Xr = S.evaluate(uu, vv)
@@ -499,12 +504,24 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
     }
     # the guard of §7 (cut_smoothing.smooth_cut): cuts where fewer sweeps were kept, and why
     report["smoothing_stops"] = [sm.stopped for sm in curves.smoothing.values() if sm.stopped]
+    #: missed tolerances and bounds, with figures (the operator reports them as warnings)
+    report["warnings"] = list(report["smoothing_stops"])
     report["tip_irregularity"] = tip_irregularity(blade, curves, settings.edge_smoothing_distance * R)
     lap("report")
     if measure:
         dev = deviation_report(blade, surfaces, params, curves)
         report["deviation_m"] = dev
         report["deviation_bound_inside_m"] = SMOOTHING_ZONE_BOUND * R
+        D = 2.0 * R
+        if dev["max_outside"] > tol:
+            worst = max((k for k in SURFACE_NAMES), key=lambda k: dev[k]["outside"])
+            report["warnings"].append(
+                f"outside the smoothing zone the surfaces depart from the blade by up to {dev['max_outside']:.3g} m "
+                f"({dev['max_outside'] / D:.3g} D, on the {worst} surface), more than the tolerance {tol:.3g} m")
+        if dev["max_inside"] > SMOOTHING_ZONE_BOUND * R:
+            report["warnings"].append(
+                f"inside the smoothing zone the surfaces depart from the blade by up to {dev['max_inside']:.3g} m "
+                f"({dev['max_inside'] / D:.3g} D), more than the bound {SMOOTHING_ZONE_BOUND * R:.3g} m")
         report["shared_edges"] = [{k: v for k, v in e.items() if k != "angles"} for e in shared_edge_report(surfaces)]
         lap("measure")
     report["times_s"]["total"] = sum(v for k, v in times.items() if k != "total")
