@@ -462,6 +462,10 @@ def smoothing_summary(smoothed) -> str:
         text += (f"; deviation from the unsmoothed blade {dev['max_outside']:.2e} m outside the smoothing zone "
                  f"(tolerance {report['tolerance_m']:.2e} m), {dev['max_inside']:.2e} m inside "
                  f"(bound {report['deviation_bound_inside_m']:.2e} m)")
+    ti = report.get("tip_irregularity")
+    if ti is not None and ti["curves"]:
+        text += (f"; tip irregularity {ti['unsmoothed']:.4g} unsmoothed -> {ti['smoothed']:.4g} smoothed "
+                 f"(x{ti['ratio']:.3f}, excess curvature variation x R over {ti['curves']} curves)")
     return text
 
 
@@ -767,6 +771,9 @@ class BLADESMITH_OT_add_propeller(bpy.types.Operator):
         finally:
             wm.progress_end()
         self.report({"INFO"}, f"{root.name}: {root.bladesmith_propeller.status}")
+        if result.smoothing is not None:
+            for warning in result.smoothing.report.get("warnings", []):
+                self.report({"WARNING"}, warning)
         return {"FINISHED"}
 
 
