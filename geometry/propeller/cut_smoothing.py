@@ -54,6 +54,8 @@ END_TAPER_FRACTION = 0.5
 #: Changes of a cut's excess curvature variation below this fraction of its unsmoothed
 #: value (plus this fraction of 1/d_e) are rounding, not a rise.
 GUARD_RELATIVE_SLACK = 1e-9
+#: The guard looks at the filter after 1, r, r², ... and n sweeps (r this ratio).
+GUARD_CHECKPOINT_RATIO = 4
 #: Power iterations that estimate the filter's largest mode, and the margin on the
 #: estimate (power iteration approaches the spectral radius from below).
 STABILITY_POWER_ITERATIONS = 200
@@ -280,8 +282,9 @@ def smooth_cut(blade, cut, tip_distance: float, *, d_t: float, d_e: float, stren
     edge_spacing (h) are in metres.
 
     The filter runs in arclength (:func:`filter_matrix`). A guard looks at it after 0,
-    1, 2, 4, 8, ... and n sweeps and keeps the checkpoint whose curve (the spline through
-    the samples) has the least excess curvature variation in the window, among those
+    1, 4, 16, ... (GUARD_CHECKPOINT_RATIO) and n sweeps and keeps the checkpoint whose
+    curve (the smoothed cut, see :class:`BlendedOffset`) has the least excess curvature
+    variation in the window (:mod:`.irregularity`), among those
     whose largest displacement stays within ``bound`` (m): more sweeps never leave the cut
     rougher than fewer, nor move it beyond the bound. When the guard keeps fewer than n
     sweeps, ``stopped`` says why, with the figures. n = 0 leaves the cut exact."""
@@ -319,7 +322,8 @@ def smooth_cut(blade, cut, tip_distance: float, *, d_t: float, d_e: float, stren
     stop = None
     last_e = first
     Y, done = Y0, 0
-    for c in sorted({min(2**k, n) for k in range(int(np.log2(n)) + 2)}):
+    levels = int(np.log(n) / np.log(GUARD_CHECKPOINT_RATIO)) + 2
+    for c in sorted({min(GUARD_CHECKPOINT_RATIO**k, n) for k in range(levels)}):
         Y = _sweeps(Y, bands, coef, c - done)
         done = c
         moved = float(np.max(np.linalg.norm(Y - Y0, axis=1)))

@@ -92,6 +92,12 @@ def tip_irregularity(blade, curves, d_e: float) -> dict:
     R = blade.radius
     per = []
     for fam, i, cut, smooth in zone_cuts(curves):
+        done = curves.smoothing.get((fam, i))
+        if done is not None and len(done.irregularity) == 2:
+            # the guard of the filter measured this cut already, with this definition
+            per.append({"curve": f"{fam} {i + 1}", "unsmoothed": done.irregularity[0] * R,
+                        "smoothed": done.irregularity[1] * R})
+            continue
         tw = measure_window(blade, cut, d_e)
         X0 = blade_points(blade, cut.curve.parameters(tw))
         off = smooth.displacement(tw)
