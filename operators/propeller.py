@@ -86,7 +86,7 @@ DEFAULT_TIP_SMOOTHING_DISTANCE = 0.05
 DEFAULT_EDGE_SMOOTHING_DISTANCE = 0.025
 DEFAULT_TRANSITION_S = 0.75
 DEFAULT_FILTER_STRENGTH = 0.5
-DEFAULT_FILTER_ITERATIONS = 50
+DEFAULT_FILTER_ITERATIONS = 100
 DEFAULT_TOLERANCE = 1e-5
 #: Above this, Eq. 29's fourth-difference filter amplifies the shortest wave
 #: (1 - 16β/6 < -1 for β > 0.75).
@@ -462,6 +462,10 @@ def smoothing_summary(smoothed) -> str:
         text += (f"; deviation from the unsmoothed blade {dev['max_outside']:.2e} m outside the smoothing zone "
                  f"(tolerance {report['tolerance_m']:.2e} m), {dev['max_inside']:.2e} m inside "
                  f"(bound {report['deviation_bound_inside_m']:.2e} m)")
+    ti = report.get("tip_irregularity")
+    if ti is not None and ti["curves"]:
+        text += (f"; tip irregularity {ti['unsmoothed']:.4g} unsmoothed -> {ti['smoothed']:.4g} smoothed "
+                 f"(x{ti['ratio']:.3f}, excess curvature variation x R over {ti['curves']} curves)")
     return text
 
 
@@ -767,6 +771,9 @@ class BLADESMITH_OT_add_propeller(bpy.types.Operator):
         finally:
             wm.progress_end()
         self.report({"INFO"}, f"{root.name}: {root.bladesmith_propeller.status}")
+        if result.smoothing is not None:
+            for warning in result.smoothing.report.get("warnings", []):
+                self.report({"WARNING"}, warning)
         return {"FINISHED"}
 
 

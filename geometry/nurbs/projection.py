@@ -507,3 +507,17 @@ def _newton_surface(surface, P, u, v, eps1, cos_tol, max_iterations):
         done |= move <= eps1
         active = active[~done]
     return u, v
+
+
+def refine_closest_points(surface: BSplineSurface, points, u, v, tol: float | None = None,
+                          cos_tol: float = COSINE_TOL, max_iterations: int = MAX_ITERATIONS):
+    """The safeguarded Newton iteration of :func:`closest_point_surface` (NURBS Book
+    Eqs. 6.6–6.8) from given start parameters, without the start grid: for callers that
+    already hold good starts (e.g. the nearest point of a dense tessellation).
+    points (n, dim), u, v (n,). Returns (u, v, distances), each (n,)."""
+    P, shape = _query_points(points, surface.dim)
+    eps1 = POINT_TOL * max(surface.size(), 1e-300) if tol is None else float(tol)
+    u, v = _newton_surface(surface, P, np.asarray(u, dtype=np.float64).ravel().copy(),
+                           np.asarray(v, dtype=np.float64).ravel().copy(), eps1, cos_tol, max_iterations)
+    dist = np.linalg.norm(surface.evaluate(u, v) - P, axis=1)
+    return u.reshape(shape), v.reshape(shape), dist.reshape(shape)

@@ -44,6 +44,24 @@ from .corners import SplineCurve, blade_points
 
 #: Largest filter strength α for which the explicit fourth-difference filter is stable.
 MAX_STABLE_FILTER_STRENGTH = 0.75
+#: Documented bound on the deviation inside the smoothing zone, as a fraction of R.
+SMOOTHING_ZONE_BOUND = 5e-3
+#: Share of that bound the filter's own displacement may use (the rest is left for the
+#: spline surfaces of §9 between the cuts).
+GUARD_BOUND_FRACTION = 0.8
+#: β tapers to 0 over this fraction of the shorter half of a cut next to its ends.
+END_TAPER_FRACTION = 0.5
+#: Changes of a cut's excess curvature variation below this fraction of its unsmoothed
+#: value (plus this fraction of 1/d_e) are rounding, not a rise.
+GUARD_RELATIVE_SLACK = 1e-9
+#: The guard looks at the filter after 1, r, r², ... and n sweeps (r this ratio).
+GUARD_CHECKPOINT_RATIO = 4
+#: Power iterations that estimate the filter's largest mode, and the margin on the
+#: estimate (power iteration approaches the spectral radius from below).
+STABILITY_POWER_ITERATIONS = 200
+STABILITY_MARGIN = 1.02
+#: Parameters of a cut's smoothing window at which the guard measures the curvature.
+GUARD_WINDOW_SAMPLES = 1201
 #: Curvature values below this fraction of the largest |κ| along a curve count as zero
 #: when sign changes are counted.
 CURVATURE_ZERO_FRACTION = 1e-3
@@ -118,11 +136,15 @@ def edge_distribution(L_first: float, L_second: float, d: float, h: float) -> np
     return t
 
 
-def fourth_difference_filter(Y: np.ndarray, beta: np.ndarray, iterations: int) -> np.ndarray:
+def fourth_difference_filter(Y: np.ndarray, beta: np.ndarray, iterations: int, spacing=None) -> np.ndarray:
     """Hally Eq. 29: ``iterations`` Jacobi sweeps of y_i += β_i/6 (-y_{i-2} + 4y_{i-1}
     - 6y_i + 4y_{i+1} - y_{i+2}) on the interior samples 2..N-3 (β_i = 0 keeps a sample
-    fixed). Y: (N, dim); beta: (N,)."""
+    fixed). Y: (N, dim); beta: (N,). With ``spacing`` (the samples' arclength s, (N,))
+    the fourth difference is taken in s (:func:`filter_matrix`), not in the index."""
     Y = np.array(Y, dtype=np.float64)
+    if spacing is not None:
+        M = filter_matrix(spacing, beta)
+        return np.linalg.matrix_power(M, int(iterations)) @ Y
     b = (np.asarray(beta, dtype=np.float64)[2:-2] / 6.0)[:, None]
     if not np.any(b):
         return Y
@@ -131,11 +153,83 @@ def fourth_difference_filter(Y: np.ndarray, beta: np.ndarray, iterations: int) -
     return Y
 
 
+def fourth_difference_weights(s: np.ndarray) -> np.ndarray:
+    """Weights W (N, N) with (W y)_i = -h_i^4 y^(4)(s_i) for the interior samples
+    2..N-3 (rows of the others are 0): y^(4) = 24 y[s_{i-2}, ..., s_{i+2}] (the fourth
+    divided difference), h_i = (s_{i+2} - s_{i-2})/4 the local spacing. On uniform
+    spacing a row is (-1, 4, -6, 4, -1), the stencil of Hally Eq. 29."""
+    s = np.asarray(s, dtype=np.float64)
+    N = s.size
+    W = np.zeros((N, N))
+    if N < 5:
+        return W
+    i = np.arange(2, N - 2)
+    cols = i[:, None] + np.arange(-2, 3)[None, :]
+    nodes = s[cols]  # (m, 5)
+    diff = nodes[:, :, None] - nodes[:, None, :]
+    diff[:, np.arange(5), np.arange(5)] = 1.0
+    w = 1.0 / np.prod(diff, axis=2)  # divided-difference weights
+    h = (nodes[:, 4] - nodes[:, 0]) / 4.0
+    W[i[:, None], cols] = -24.0 * h[:, None] ** 4 * w
+    return W
+
+
+def filter_matrix(s: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """One sweep of the filter as a matrix, M = I + diag(β/6) W (W of
+    :func:`fourth_difference_weights`, the fourth difference in arclength s), with β
+    already scaled by :func:`stable_strength_scale`.
+
+    Why not the index: on tanh-clustered samples the index-space stencil of Eq. 29 is
+    not a fourth derivative (it carries the growth of the spacing), so many sweeps drive
+    the points towards a cubic in the index, which is not a smooth curve in space; that
+    is why strong settings roughened the tip. In s the fixed point of the sweeps is a
+    cubic in arclength."""
+    beta = np.asarray(beta, dtype=np.float64)
+    W = fourth_difference_weights(s)
+    scale = stable_strength_scale(W, beta)
+    return np.eye(len(beta)) + scale * (beta / 6.0)[:, None] * W
+
+
+def stable_strength_scale(W: np.ndarray, beta: np.ndarray) -> float:
+    """The factor (<= 1) on β that keeps a sweep y <- (I + B) y, B = diag(β/6) W, from
+    growing its largest mode: the spectral radius ρ of B is estimated by power iteration
+    (STABILITY_POWER_ITERATIONS products, times STABILITY_MARGIN) and β scaled so that
+    ρ <= 2, the limit of the explicit filter (on uniform samples ρ = 16 α/6: α = 3/4 is
+    then scaled by 1/1.02; on Hally's nearly geometric samples the factor stays close to 1). The guard of
+    :func:`smooth_cut` catches any slower growth (rougher or moved beyond the bound)."""
+    active = np.flatnonzero(beta > 0)
+    if active.size == 0:
+        return 1.0
+    B = (beta[active] / 6.0)[:, None] * W[np.ix_(active, active)]
+    x = np.random.default_rng(0).standard_normal(active.size)
+    rho = 0.0
+    for _ in range(STABILITY_POWER_ITERATIONS):
+        y = B @ x
+        rho = float(np.linalg.norm(y))
+        if rho == 0.0:
+            return 1.0
+        x = y / rho
+    return min(1.0, 2.0 / (STABILITY_MARGIN * rho))
+
+
+def _sweeps(Y: np.ndarray, weights: np.ndarray, coef: np.ndarray, count: int) -> np.ndarray:
+    """``count`` sweeps y_i += coef_i Σ_k weights_ik y_{i-2+k} on samples 2..N-3 (the banded
+    form of :func:`filter_matrix`; weights (N-4, 5), coef (N-4,))."""
+    Y = np.array(Y, dtype=np.float64)
+    w = [(coef * weights[:, k])[:, None] for k in range(5)]
+    for _ in range(int(count)):
+        Y[2:-2] += w[0] * Y[:-4] + w[1] * Y[1:-3] + w[2] * Y[2:-2] + w[3] * Y[3:-1] + w[4] * Y[4:]
+    return Y
+
+
 @dataclass(frozen=True, eq=False)
 class SmoothedCut:
-    """A cut after Hally §7: ``curve`` (the exact cut plus the displacement spline),
-    the samples t (N,), the points before (N, 3) and after (N, 3) filtering, β (N,),
-    and the largest displacement (m)."""
+    """A cut after Hally §7: ``curve`` (the exact cut blended into the spline of the
+    smoothed samples), the samples t (N,), the points before (N, 3) and after (N, 3)
+    filtering, β (N,), the largest displacement (m), the sweeps kept (``iterations``:
+    fewer than asked when the guard stopped the filter), ``stopped`` (None, or why and
+    with which figures the guard stopped early) and ``irregularity`` (the guard's excess
+    curvature variation of the cut before and after, 1/m)."""
 
     curve: SplineCurve
     t: np.ndarray
@@ -143,25 +237,113 @@ class SmoothedCut:
     after: np.ndarray
     beta: np.ndarray
     max_displacement: float
+    iterations: int = 0
+    stopped: str | None = None
+    irregularity: tuple = ()
+
+
+class BlendedOffset:
+    """The displacement of a smoothed cut from b(p(t)) (Hally §7). Inside the filter's
+    window the smoothed curve is Hally's cubic spline S through the smoothed samples;
+    outside it, the exact cut plus the spline of the sample displacements d(t); the
+    weight w(t) (the in-cut factor f(|y - x_1|/d_e) of Eq. 30 at the samples, splined)
+    blends them:
+
+        c(t) = b(p(t)) + d(t) + w(t) (S(t) - b(p(t)) - d(t)).
+
+    Both curves pass through the smoothed samples, so c does too. Inside the window the
+    exact cut's features finer than the sample spacing h are not kept: they are the tip
+    irregularities the smoothing is for (with the exact cut plus d(t) alone, the
+    filter could never remove them, which is why the defaults changed nothing)."""
+
+    def __init__(self, blade, parameters, spline, disp, weight):
+        self.blade, self.parameters, self.spline, self.disp, self.weight = blade, parameters, spline, disp, weight
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=np.float64)
+        return self.on_exact(t, None)
+
+    def on_exact(self, t, X):
+        """The displacement at t; X: the exact cut b(p(t)) there when already known."""
+        d = self.disp(t)
+        w = np.clip(self.weight(t), 0.0, 1.0)
+        out = np.array(d)
+        on = w > 0.0
+        if np.any(on):
+            Xo = blade_points(self.blade, self.parameters.parameters(t[on])) if X is None else X[on]
+            out[on] = d[on] + w[on, None] * (self.spline(t[on]) - Xo - d[on])
+        return out
 
 
 def smooth_cut(blade, cut, tip_distance: float, *, d_t: float, d_e: float, strength: float,
-               iterations: int, spacing: float, edge_spacing: float) -> SmoothedCut:
+               iterations: int, spacing: float, edge_spacing: float, bound: float | None = None) -> SmoothedCut:
     """Sample, filter and re-spline one cut (Hally Eqs. 25–30). ``tip_distance`` is a,
     the distance along the edge from x_1 to the tip (m); d_t, d_e, spacing (d) and
-    edge_spacing (h) are in metres."""
+    edge_spacing (h) are in metres.
+
+    The filter runs in arclength (:func:`filter_matrix`). A guard looks at it after 0,
+    1, 4, 16, ... (GUARD_CHECKPOINT_RATIO) and n sweeps and keeps the checkpoint whose
+    curve (the smoothed cut, see :class:`BlendedOffset`) has the least excess curvature
+    variation in the window (:mod:`.irregularity`), among those
+    whose largest displacement stays within ``bound`` (m): more sweeps never leave the cut
+    rougher than fewer, nor move it beyond the bound. When the guard keeps fewer than n
+    sweeps, ``stopped`` says why, with the figures. n = 0 leaves the cut exact."""
+    from .irregularity import curve_excess, measure_window
+
     x0, x1, x2 = cut.points
     t = edge_distribution(float(np.linalg.norm(x1 - x0)), float(np.linalg.norm(x1 - x2)), spacing, edge_spacing)
     Y0 = blade_points(blade, cut.curve.parameters(t))
-    beta = strength * bump(tip_distance / d_t) * bump(np.linalg.norm(Y0 - x1, axis=1) / d_e)  # Eq. 30
-    mid = (len(t) - 1) // 2
-    beta[[0, 1, mid, -2, -1]] = 0.0
-    Y = fourth_difference_filter(Y0, beta, iterations)
-    disp = Y - Y0
-    offset = make_interp_spline(t, disp, k=3)
+    in_cut = bump(np.linalg.norm(Y0 - x1, axis=1) / d_e)
+    # β falls smoothly to 0 towards the ends, which stay on c_9/c_10 (c_5..c_8): a pinned
+    # end inside the window would put a kink into the cut next to it
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(Y0, axis=0), axis=1))])
+    to_end = np.minimum(s, s[-1] - s)
+    taper = 1.0 - bump(to_end / (END_TAPER_FRACTION * min(s[len(t) // 2], s[-1] - s[len(t) // 2])))
+    beta = strength * bump(tip_distance / d_t) * in_cut * taper  # Eq. 30
+    beta[[0, 1, -2, -1]] = 0.0
+    n = int(iterations)
+    if n == 0 or not np.any(beta > 0):
+        return SmoothedCut(curve=cut.curve, t=t, before=Y0, after=Y0, beta=beta, max_displacement=0.0)
+    W = fourth_difference_weights(s)
+    coef = stable_strength_scale(W, beta) * beta[2:-2] / 6.0
+    rows = np.arange(2, len(t) - 2)
+    bands = W[rows[:, None], rows[:, None] + np.arange(-2, 3)[None, :]]
+    tw = measure_window(blade, cut, d_e)
+    Xw = blade_points(blade, cut.curve.parameters(tw))
+    weight = make_interp_spline(t, in_cut, k=3)
+
+    def candidate(Y):
+        disp = Y - Y0
+        off = BlendedOffset(blade, cut.curve, make_interp_spline(t, Y, k=3), make_interp_spline(t, disp, k=3), weight)
+        return off, curve_excess(tw, Xw + off.on_exact(tw, Xw))
+
+    first = curve_excess(tw, Xw)
+    best_e, best_n, best_Y, best_off = first, 0, Y0, None
+    stop = None
+    last_e = first
+    Y, done = Y0, 0
+    levels = int(np.log(n) / np.log(GUARD_CHECKPOINT_RATIO)) + 2
+    for c in sorted({min(GUARD_CHECKPOINT_RATIO**k, n) for k in range(levels)}):
+        Y = _sweeps(Y, bands, coef, c - done)
+        done = c
+        moved = float(np.max(np.linalg.norm(Y - Y0, axis=1)))
+        if bound is not None and moved > bound:
+            stop = (f"kept {best_n} of {n} sweeps: {c} sweeps would move the cut by {moved:.3g} m, "
+                    f"beyond the deviation bound {bound:.3g} m")
+            break
+        off, last_e = candidate(Y)
+        if last_e <= best_e + GUARD_RELATIVE_SLACK * first + GUARD_RELATIVE_SLACK / d_e:
+            best_e, best_n, best_Y, best_off = last_e, c, Y, off
+    if stop is None and best_n != n and last_e > best_e + GUARD_RELATIVE_SLACK * first + GUARD_RELATIVE_SLACK / d_e:
+        stop = (f"kept {best_n} of {n} sweeps: more sweeps raise the cut's excess curvature variation "
+                f"({best_e:.4g} 1/m at {best_n} sweeps, {last_e:.4g} 1/m at {n}; unsmoothed {first:.4g} 1/m)")
+    if best_n == 0:
+        return SmoothedCut(curve=cut.curve, t=t, before=Y0, after=Y0, beta=beta, max_displacement=0.0,
+                           stopped=stop, irregularity=(first, first))
     return SmoothedCut(
-        curve=replace(cut.curve, offset=offset), t=t, before=Y0, after=Y, beta=beta,
-        max_displacement=float(np.max(np.linalg.norm(disp, axis=1))),
+        curve=replace(cut.curve, offset=best_off), t=t, before=Y0, after=best_Y, beta=beta,
+        max_displacement=float(np.max(np.linalg.norm(best_Y - Y0, axis=1))), iterations=best_n, stopped=stop,
+        irregularity=(first, best_e),
     )
 
 

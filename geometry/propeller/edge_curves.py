@@ -40,7 +40,7 @@ from scipy.interpolate import make_interp_spline
 
 from ..errors import DefinitionError, GeometryError
 from .corners import Corners, HubCurve, ParameterCurve, SplineCurve, blade_points, hub_edge_curves, top_edge_curves
-from .cut_smoothing import smooth_cut
+from .cut_smoothing import GUARD_BOUND_FRACTION, SMOOTHING_ZONE_BOUND, smooth_cut
 from .cuts import BladeCache, march_cuts
 
 #: Samples of each edge (in w = sqrt(1 - η)) for the arclength of c_LETE.
@@ -288,7 +288,8 @@ def build_edge_curves(blade, corners: Corners, sides: dict, settings, progress=N
         progress("cuts", 1.0)
     # --- smoothing (§7)
     kw = dict(d_t=d_t, d_e=d_e, strength=settings.filter_strength, iterations=settings.filter_iterations,
-              spacing=settings.sample_spacing * R, edge_spacing=settings.sample_spacing * settings.edge_spacing_ratio * R)
+              spacing=settings.sample_spacing * R, edge_spacing=settings.sample_spacing * settings.edge_spacing_ratio * R,
+              bound=GUARD_BOUND_FRACTION * SMOOTHING_ZONE_BOUND * R)
     smoothing = {}
 
     def finish(cut, s_edge, key):

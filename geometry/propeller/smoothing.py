@@ -29,13 +29,17 @@ from .blade_surfaces import (
     fit_rows,
 )
 from .corners import DefiningPoints, blade_derivatives, blade_points, check_corner_order, corner_points
-from .cut_smoothing import MAX_STABLE_FILTER_STRENGTH, curvature_sign_changes, spline_signed_curvature
+from .cut_smoothing import (
+    MAX_STABLE_FILTER_STRENGTH,
+    SMOOTHING_ZONE_BOUND,
+    curvature_sign_changes,
+    spline_signed_curvature,
+)
 from .edge_curves import EdgeCurveSet, build_edge_curves
+from .irregularity import tip_irregularity
 from .side_curves import side_curves
 
 SURFACE_NAMES = ("pressure_central", "suction_central", "leading_edge", "trailing_edge", "tip")
-#: Documented bound on the deviation inside the smoothing zone, as a fraction of R.
-SMOOTHING_ZONE_BOUND = 5e-3
 #: Fraction of a tip-surface edge at each end left out of the normal-angle check: the
 #: tip surface meets c_9/c_12 (and c_10/c_12, c_9/c_11, c_10/c_11) at corners where its
 #: boundary curves continue each other (corner angle ~180°), so S_u and S_v are nearly
@@ -43,6 +47,19 @@ SMOOTHING_ZONE_BOUND = 5e-3
 TIP_CORNER_EXCLUSION = 0.02
 #: Newton iterations of the closest-point projection onto b.
 PROJECTION_ITERATIONS = 12
+#: Samples per direction of each surface in the deviation report, and Newton iterations.
+DEVIATION_SAMPLES = 31
+DEVIATION_ITERATIONS = 25
+#: Refinement of the deviation maxima: the worst samples, and points per direction.
+DEVIATION_WORST = 6
+#: Samples of the tip surface per interval between its cuts, across them.
+DEVIATION_TIP_PER_CUT = 4
+DEVIATION_REFINE = 9
+#: Seed grid on b for projecting the tip surface (ξ by w = sqrt(1 - η)), from this far
+#: below the lowest η of the tip cuts.
+SEED_XI = 480
+SEED_W = 120
+SEED_ETA_MARGIN = 0.02
 
 
 @dataclass(frozen=True)
@@ -61,7 +78,8 @@ class SmoothingSettings:
         half-way down the leading edge, Hally's advice).
     filter_strength: α of Eq. 30 (0 < α <= 0.75, the stability limit of Eq. 29).
         Default 0.5.
-    filter_iterations: n of Eq. 29. Default 50.
+    filter_iterations: n of Eq. 29. Default 100 (the filter works in arclength and
+        is guarded, see :func:`~.cut_smoothing.smooth_cut`).
     tolerance: the accuracy of the spline curves (§9). Default 2e-5 (= 1e-5 D).
     sample_spacing: d of Eqs. 27–28, the largest spacing of the cut samples (§7).
         Default 0.01.
@@ -74,7 +92,7 @@ class SmoothingSettings:
     edge_smoothing_distance: float = 0.05
     transition_s: float = 0.75
     filter_strength: float = 0.5
-    filter_iterations: int = 50
+    filter_iterations: int = 100
     tolerance: float = 2e-5
     sample_spacing: float = 0.01
     edge_spacing_ratio: float = 0.01
@@ -269,33 +287,95 @@ def _zone_mask(smoothed: np.ndarray, coord: np.ndarray) -> np.ndarray:
     return (k >= idx.min() - 1) & (k <= idx.max() + 1)
 
 
-def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curves: EdgeCurveSet, samples: int = 41):
+class BladeSeeds:
+    """Nearest points of a grid on b above η_low (ξ uniform, η = 1 - w² with w uniform,
+    so the grid closes on the tip like the blade does), for starting projections: a
+    KD-tree over n_xi × n_w points."""
+
+    def __init__(self, blade, eta_low: float, n_xi: int = None, n_w: int = None):
+        from scipy.spatial import cKDTree
+
+        n_xi = SEED_XI if n_xi is None else n_xi
+        n_w = SEED_W if n_w is None else n_w
+        xi = np.arange(n_xi) / n_xi
+        w = np.linspace(0.0, np.sqrt(1.0 - max(eta_low, blade.eta_min)), n_w)
+        XI, W = np.meshgrid(xi, w, indexing="ij")
+        self.params = np.stack([XI.ravel(), 1.0 - W.ravel() ** 2], axis=1)
+        self.tree = cKDTree(blade.evaluate(self.params[:, 0], self.params[:, 1]))
+
+    def nearest(self, X) -> np.ndarray:
+        _, idx = self.tree.query(np.asarray(X, dtype=np.float64))
+        return self.params[idx]
+
+
+def _project(blade, X, starts):
+    """Shortest closest-point distance over several start parameter sets."""
+    best_d, best_p = None, None
+    for P in starts:
+        d, p = project_to_blade(blade, X, P, iterations=DEVIATION_ITERATIONS)
+        if best_d is None:
+            best_d, best_p = d, p
+        else:
+            take = d < best_d
+            best_d, best_p = np.where(take, d, best_d), np.where(take[:, None], p, best_p)
+    return best_d, best_p
+
+
+def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curves: EdgeCurveSet,
+                     samples: int = DEVIATION_SAMPLES):
     """Closest-point distance from the surfaces to the unsmoothed blade, split into the
-    smoothing zone and the rest (metres): dict per surface and overall maxima."""
+    smoothing zone and the rest (metres): dict per surface and overall maxima.
+
+    Samples: a ``samples``² grid of each surface, then a finer grid (DEVIATION_REFINE²
+    points over one cell each way) around the DEVIATION_WORST largest samples inside and
+    outside the zone, so the maxima are the surface's and not the coarse grid's. Starts:
+    the companion parameters; on the tip (which has none, its parameters jump between ξ
+    branches across the tip), the nearest cut and the nearest point of a grid on b
+    (:class:`BladeSeeds`), keeping the shorter distance: from the cut alone the
+    projection can end in a far local minimum where the parameter lines crowd."""
     t = np.linspace(0.0, 1.0, samples)
-    U, V = np.meshgrid(t, t, indexing="ij")
-    u, v = U.ravel(), V.ravel()
-    zone_coord = {"leading_edge": (curves.smoothed_leading, v), "trailing_edge": (curves.smoothed_trailing, v),
-                  "tip": (curves.smoothed_tip, u)}
+    seeds = None
     out = {}
     for name, S in smoothed_surfaces.items():
+        # the tip surface across its cuts: DEVIATION_TIP_PER_CUT samples per interval (the
+        # surface is exact on the cuts; it departs from b between them)
+        tu = np.linspace(0.0, 1.0, DEVIATION_TIP_PER_CUT * (len(curves.tip) - 1) + 1) if name == "tip" else t
+        U, V = np.meshgrid(tu, t, indexing="ij")
+        u, v = U.ravel(), V.ravel()
+        zone_coord = {"leading_edge": (curves.smoothed_leading, v), "trailing_edge": (curves.smoothed_trailing, v),
+                      "tip": (curves.smoothed_tip, u)}
+        local = np.stack(np.meshgrid(np.linspace(-1, 1, DEVIATION_REFINE) / (tu.size - 1),
+                                     np.linspace(-1, 1, DEVIATION_REFINE) / (samples - 1), indexing="ij"))
         X = S.evaluate(u, v)
         if name == "tip":
-            # the tip's parameters jump between ξ branches across the tip (no continuous
-            # companion): start from the nearest tip cut instead
             k = np.rint(u * (len(curves.tip) - 1)).astype(int)
             P = np.empty((u.size, 2))
             for kk in np.unique(k):
                 P[k == kk] = curves.tip[kk].parameters(v[k == kk])
+            if seeds is None:
+                seeds = BladeSeeds(blade, float(P[:, 1].min()) - SEED_ETA_MARGIN)
+            d, p = _project(blade, X, [P, seeds.nearest(X)])
         else:
-            P = param_surfaces[name].evaluate(u, v)
-        d, _ = project_to_blade(blade, X, P)
+            d, p = _project(blade, X, [param_surfaces[name].evaluate(u, v)])
         if name in zone_coord:
             zone = _zone_mask(*zone_coord[name])
         else:
             zone = np.zeros(d.shape, dtype=bool)
-        out[name] = {"outside": float(d[~zone].max()) if np.any(~zone) else 0.0,
-                     "inside": float(d[zone].max()) if np.any(zone) else 0.0}
+        res = {}
+        for key, mask in (("outside", ~zone), ("inside", zone)):
+            if not np.any(mask):
+                res[key] = 0.0
+                continue
+            idx = np.flatnonzero(mask)
+            top = idx[np.argsort(d[idx])[-DEVIATION_WORST:]]
+            du, dv = local
+            uu = np.clip(u[top, None] + du.ravel()[None], 0.0, 1.0).ravel()
+            vv = np.clip(v[top, None] + dv.ravel()[None], 0.0, 1.0).ravel()
+            Xr = S.evaluate(uu, vv)
+            other = seeds.nearest(Xr) if name == "tip" else param_surfaces[name].evaluate(uu, vv)
+            dr, _ = _project(blade, Xr, [np.repeat(p[top], du.size, axis=0), other])
+            res[key] = float(max(d[idx].max(), dr.max()))
+        out[name] = res
     out["max_outside"] = max(v["outside"] for v in out.values() if isinstance(v, dict))
     out["max_inside"] = max(v["inside"] for v in out.values() if isinstance(v, dict))
     return out
@@ -422,11 +502,26 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
         "max_smoothing_displacement_m": max([s.max_displacement for s in curves.smoothing.values()], default=0.0),
         "times_s": times,
     }
+    # the guard of §7 (cut_smoothing.smooth_cut): cuts where fewer sweeps were kept, and why
+    report["smoothing_stops"] = [sm.stopped for sm in curves.smoothing.values() if sm.stopped]
+    #: missed tolerances and bounds, with figures (the operator reports them as warnings)
+    report["warnings"] = list(report["smoothing_stops"])
+    report["tip_irregularity"] = tip_irregularity(blade, curves, settings.edge_smoothing_distance * R)
     lap("report")
     if measure:
         dev = deviation_report(blade, surfaces, params, curves)
         report["deviation_m"] = dev
         report["deviation_bound_inside_m"] = SMOOTHING_ZONE_BOUND * R
+        D = 2.0 * R
+        if dev["max_outside"] > tol:
+            worst = max((k for k in SURFACE_NAMES), key=lambda k: dev[k]["outside"])
+            report["warnings"].append(
+                f"outside the smoothing zone the surfaces depart from the blade by up to {dev['max_outside']:.3g} m "
+                f"({dev['max_outside'] / D:.3g} D, on the {worst} surface), more than the tolerance {tol:.3g} m")
+        if dev["max_inside"] > SMOOTHING_ZONE_BOUND * R:
+            report["warnings"].append(
+                f"inside the smoothing zone the surfaces depart from the blade by up to {dev['max_inside']:.3g} m "
+                f"({dev['max_inside'] / D:.3g} D), more than the bound {SMOOTHING_ZONE_BOUND * R:.3g} m")
         report["shared_edges"] = [{k: v for k, v in e.items() if k != "angles"} for e in shared_edge_report(surfaces)]
         lap("measure")
     report["times_s"]["total"] = sum(v for k, v in times.items() if k != "total")

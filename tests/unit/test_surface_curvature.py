@@ -332,3 +332,25 @@ def test_span_parameters_and_errors():
         sc.surface_curvature_grid(sphere(), [0.5], [0.5]).mvs_density
     with pytest.raises(GeometryError):
         sc.surface_curvature_grid(sphere(), [0.5], [0.5]).quantity("bogus")
+
+
+
+def test_signed_deviation_vectorised_matches_the_general_projection():
+    """Issue 15: the vectorised projection (tessellation start + Newton) finds the same
+    closest points as closest_point_surface, also next to the closed trailing edge (the
+    seam u = 0 = 1 of the display surface): the smoothed DTMB 4119 trailing-edge surface
+    against the unsmoothed blade."""
+    import pathlib
+
+    from bladesmith.geometry.propeller import Propeller
+    from bladesmith.geometry.propeller.display import blade_display_surface
+    from bladesmith.geometry.propeller.smoothing import smooth_blade
+
+    model = Propeller.from_toml(pathlib.Path(__file__).resolve().parents[2] / "data" / "propellers" / "dtmb4119.toml").build()
+    te = smooth_blade(model, measure=False).trailing_edge
+    ref = blade_display_surface(model.blade, 2e-4 * model.blade.radius).surface
+    t = np.linspace(0.0, 1.0, 25)
+    pts = te.evaluate_grid(t, np.linspace(0.05, 0.95, 8)).reshape(-1, 3)
+    fast = sc.signed_deviation(pts, ref)
+    general = sc.signed_deviation(pts, ref, candidates=8)
+    assert np.allclose(fast, general, atol=1e-9 * model.blade.radius)

@@ -165,3 +165,35 @@ def test_left_handed_blade():
     assert 0.5 < p[0, 0] < 1.0
     for name, s in sb.named_surfaces.items():
         assert np.all(np.isfinite(s.control_points)), name
+
+
+@pytest.mark.parametrize("fail", ["newton", "newton_and_xi"])
+def test_fallbacks_of_eqs_21_22_when_newton_fails(dtmb, monkeypatch, fail):
+    """Hally §6: when the Newton search along Eq. 20 fails, the ξ-search of Eq. 21 is
+    tried, then the bisection of Eq. 22. Newton (and the ξ-search) are made to fail; the
+    cuts are still found, exactly on their planes, and the fallbacks are counted."""
+    from bladesmith.geometry.propeller import cuts as cuts_module
+
+    def refuse(self, trial, *args):
+        return trial.copy(), np.zeros(len(trial), dtype=bool)
+
+    monkeypatch.setattr(cuts_module._PlaneSolver, "newton_line", refuse)
+    if fail == "newton_and_xi":
+        monkeypatch.setattr(cuts_module._PlaneSolver, "xi_search", refuse)
+    b = dtmb.blade
+    p0 = np.array([[0.4, 0.6], [0.3, 0.9]])
+    p1 = np.array([[0.5, 0.6], [0.0, 0.999]])
+    p2 = np.array([[0.6, 0.6], [-0.3, 0.9]])
+    found = march_cuts(b, p0, p1, p2)
+    xi = sum(c.fallbacks.get("xi_search", 0) for c in found)
+    bis = sum(c.fallbacks.get("bisection", 0) for c in found)
+    if fail == "newton":
+        assert xi > 0
+    else:
+        assert xi == 0 and bis > 0
+    for cut in found:
+        Xn = b.evaluate(cut.params[:, 0], cut.params[:, 1])
+        assert np.abs((Xn - cut.points[0]) @ cut.normal).max() < 1e-8 * b.radius
+        # between the nodes the spline stays on the blade and near the plane (the fallbacks
+        # do not keep the spacing of Eq. 23)
+        assert cut.plane_residual(b, np.linspace(0, 1, 501)).max() < 5e-5 * b.radius

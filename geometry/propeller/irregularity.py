@@ -1,0 +1,110 @@
+"""A measure of tip irregularity: how much the curvature of the curves near the tip
+wanders beyond what a single rounded edge needs (issue 15; the irregularities of Hally
+2013 §1 that tip smoothing, §7, exists to remove).
+
+Definition. For one curve around an edge (a blade cut, Hally §6) take its signed in-plane
+curvature κ(t) on the part within d_e of its edge point x_1 (the window where Eq. 30
+lets the filter act), and
+
+    E = TV(κ) - |κ_pk - κ_a| - |κ_pk - κ_b|,      TV(κ) = ∫ |dκ/dt| dt,
+
+κ_a, κ_b the curvature at the two ends of the window and κ_pk the curvature of largest
+magnitude in it. A fair rounded edge (curvature rising to one peak at the edge and
+falling again) has E = 0; every extra wiggle of amplitude A adds 2A. E does not depend on
+the direction of travel or the sign convention of κ. The tip irregularity of a blade is
+the sum of E·R (R the radius: dimensionless) over every curve whose edge point lies
+within d_t of the tip along c_LETE (Hally Eq. 30, the cuts that are smoothed).
+
+Both sides use the same window and the same evaluation: the curve (the plain cut b(p(t))
+or the smoothed one, b(p(t)) plus its displacement, Hally §7) at WINDOW_SAMPLES parameters
+evenly spread over the part of the plain cut within d_e of x_1, interpolated by a cubic
+spline in t whose curvature is taken at those parameters. The measure is taken on the
+curves, not on the §9 rows fitted to them: near the tip the edge radius of the last cuts
+is below the fitting tolerance, so the rows' curvature there reflects the fit.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.interpolate import make_interp_spline
+
+from .corners import blade_points
+
+#: Parameters per window at which a curve's curvature is measured.
+WINDOW_SAMPLES = 1201
+#: Parameters at which the plain cut is scanned for its window.
+WINDOW_SCAN = 2001
+
+
+def excess_curvature_variation(kappa) -> float:
+    """E of the module docstring for a sampled curvature κ_1..κ_n (1/m): the total
+    variation beyond one rise to the peak and one fall from it (>= 0)."""
+    k = np.asarray(kappa, dtype=np.float64)
+    k = k[np.isfinite(k)]
+    if k.size < 3:
+        return 0.0
+    tv = float(np.sum(np.abs(np.diff(k))))
+    pk = k[np.argmax(np.abs(k))]
+    return max(0.0, tv - abs(pk - k[0]) - abs(pk - k[-1]))
+
+
+def measure_window(blade, cut, d_e: float) -> np.ndarray:
+    """WINDOW_SAMPLES parameters spread evenly over the part of the plain cut within d_e
+    (m) of its edge point x_1 (the window of Hally Eq. 30)."""
+    t = np.linspace(0.0, 1.0, WINDOW_SCAN)
+    X = blade_points(blade, cut.curve.parameters(t))
+    inside = np.flatnonzero(np.linalg.norm(X - cut.points[1], axis=1) < d_e)
+    lo, hi = t[max(inside[0] - 1, 0)], t[min(inside[-1] + 1, t.size - 1)]
+    return np.linspace(lo, hi, WINDOW_SAMPLES)
+
+
+def curve_excess(t, X) -> float:
+    """E (1/m) of the curve through the points X (n, 3) at parameters t (n,): the
+    cubic interpolating spline's curvature (in the plane of its mean binormal) at t."""
+    S = make_interp_spline(t, X, k=3)
+    d1, d2 = S(t, 1), S(t, 2)
+    c = np.cross(d1, d2)
+    n = np.sum(c, axis=0)
+    nn = np.linalg.norm(n)
+    if nn == 0.0:
+        return 0.0
+    return excess_curvature_variation((c @ (n / nn)) / np.linalg.norm(d1, axis=1) ** 3)
+
+
+def zone_cuts(curves) -> list[tuple[str, int, object, object]]:
+    """(family, index, plain cut, smoothed curve) for every curve of the smoothing zone."""
+    out = []
+    for i, flag in enumerate(curves.smoothed_tip):
+        if flag:
+            out.append(("tip", i, curves.cuts["tip"][i], curves.tip[i]))
+    for fam, flags, smooth in (("leading", curves.smoothed_leading, curves.leading),
+                               ("trailing", curves.smoothed_trailing, curves.trailing)):
+        for i, cut in curves.cuts[fam].items():
+            if flags[i]:
+                out.append((fam, i, cut, smooth[i]))
+    return out
+
+
+def tip_irregularity(blade, curves, d_e: float) -> dict:
+    """The tip irregularity (module docstring) before and after smoothing:
+    {"unsmoothed": ΣE·R, "smoothed": ΣE·R, "ratio": smoothed/unsmoothed, "curves": n,
+    "per_curve": [{"curve": "tip 12", "unsmoothed": E·R, "smoothed": E·R}, ...]}.
+    d_e in metres."""
+    R = blade.radius
+    per = []
+    for fam, i, cut, smooth in zone_cuts(curves):
+        done = curves.smoothing.get((fam, i))
+        if done is not None and len(done.irregularity) == 2:
+            # the guard of the filter measured this cut already, with this definition
+            per.append({"curve": f"{fam} {i + 1}", "unsmoothed": done.irregularity[0] * R,
+                        "smoothed": done.irregularity[1] * R})
+            continue
+        tw = measure_window(blade, cut, d_e)
+        X0 = blade_points(blade, cut.curve.parameters(tw))
+        off = smooth.displacement(tw)
+        X1 = X0 if off is None else blade_points(blade, smooth.parameters(tw)) + off
+        per.append({"curve": f"{fam} {i + 1}", "unsmoothed": curve_excess(tw, X0) * R,
+                    "smoothed": curve_excess(tw, X1) * R})
+    before = float(sum(p["unsmoothed"] for p in per))
+    after = float(sum(p["smoothed"] for p in per))
+    return {"unsmoothed": before, "smoothed": after, "ratio": after / before if before > 0 else 1.0,
+            "curves": len(per), "per_curve": per}
