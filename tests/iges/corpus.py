@@ -87,13 +87,19 @@ def _brep_to_iges(brep: pathlib.Path, out_faces: pathlib.Path, out_solid: pathli
     shape = TopoDS_Shape()
     if not BRepTools.Read_s(shape, str(brep), BRep_Builder()) or shape.IsNull():
         raise CorpusUnavailable(f"OpenCASCADE cannot read {brep.name}")
-    for mode, out in ((0, out_faces), (1, out_solid)):
-        Interface_Static.SetIVal_s("write.iges.brep.mode", mode)
-        w = IGESControl_Writer("MM", mode)
-        w.AddShape(shape)
-        w.ComputeModel()
-        if not w.Write(str(out)):
-            raise CorpusUnavailable(f"IGESControl_Writer failed on {brep.name}")
+    # OCC's static parameters are process-wide: restore them, or every later OCC read or
+    # write in the test session (other modules' tests) would run with ours
+    before = Interface_Static.IVal_s("write.iges.brep.mode")
+    try:
+        for mode, out in ((0, out_faces), (1, out_solid)):
+            Interface_Static.SetIVal_s("write.iges.brep.mode", mode)
+            w = IGESControl_Writer("MM", mode)
+            w.AddShape(shape)
+            w.ComputeModel()
+            if not w.Write(str(out)):
+                raise CorpusUnavailable(f"IGESControl_Writer failed on {brep.name}")
+    finally:
+        Interface_Static.SetIVal_s("write.iges.brep.mode", before)
 
 
 @dataclass(frozen=True)
@@ -160,12 +166,18 @@ def occ_summary(path):
 
     t = time.perf_counter()
     reader = IGESControl_Reader()  # first: it creates the static parameters set below
+    # process-wide: set for this read only, so that other tests' OCC reads keep OCC's
+    # default output unit (mm)
+    before = Interface_Static.CVal_s("xstep.cascade.unit")
     if not Interface_Static.SetCVal_s("xstep.cascade.unit", "M"):
         raise RuntimeError("cannot set OpenCASCADE's output unit to metres")
-    if reader.ReadFile(str(path)) != IFSelect_RetDone:
-        return None, None, time.perf_counter() - t
-    reader.TransferRoots()
-    shape = reader.OneShape()
+    try:
+        if reader.ReadFile(str(path)) != IFSelect_RetDone:
+            return None, None, time.perf_counter() - t
+        reader.TransferRoots()
+        shape = reader.OneShape()
+    finally:
+        Interface_Static.SetCVal_s("xstep.cascade.unit", before)
     dt = time.perf_counter() - t
     n = 0
     exp = TopExp_Explorer(shape, TopAbs_FACE)
