@@ -95,7 +95,7 @@ class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper):
         self.report(
             {"INFO"},
             f"Imported {airfoil.name!r} ({airfoil.format}, {len(airfoil.outline)} points, "
-            f"{'sharp' if te == 0 else f'blunt {te:.4g} c'} trailing edge)",
+            f"{'sharp' if airfoil.sharp_trailing_edge else f'blunt {te:.4g} c'} trailing edge)",
         )
         return {"FINISHED"}
 
