@@ -119,9 +119,20 @@ def check_count(count: int, maximum: int, bound_name: str, path, field: str, wha
                               field=field)
 
 
-def number(value, path, field: str, *, lo=None, hi=None, lo_open=False, hi_open=False, integer=False) -> float:
+def number(value, path, field: str, *, lo=None, hi=None, lo_open=False, hi_open=False, integer=False,
+           entry: str = "") -> float:
     """A finite number (bools refused) in [lo, hi] (open ends when asked); ``integer``
-    also refuses a fractional value and returns an int."""
+    also refuses a fractional value and returns an int. ``entry`` (e.g. "entry 3: ")
+    starts the message when the value is one of a list."""
+    try:
+        return _number(value, path, field, lo, hi, lo_open, hi_open, integer)
+    except DefinitionError as exc:
+        if not entry:
+            raise
+        raise DefinitionError(entry + str(exc).rsplit(f"field '{field}': ", 1)[-1], path=path, field=field) from None
+
+
+def _number(value, path, field, lo, hi, lo_open, hi_open, integer):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise DefinitionError(f"expected {'an integer' if integer else 'a number'}, got {_fmt(value)}", path=path,
                               field=field)
@@ -160,5 +171,5 @@ def number_list(value, path, field: str, *, maximum: int, bound_name: str, minim
         raise DefinitionError(f"expected at least {minimum} {what}, got {len(value)}", path=path, field=field)
     out = []
     for i, v in enumerate(value):
-        out.append(number(v, path, f"{field}[{i}]", lo=lo, hi=hi))
+        out.append(number(v, path, field, lo=lo, hi=hi, entry=f"entry {i}: "))
     return tuple(out)

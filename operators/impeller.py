@@ -23,6 +23,7 @@ from ..geometry.compressor import ImpellerDefinition, blade_net, distribution, d
 from ..geometry.compressor.export import impeller_surfaces
 from ..geometry.errors import BladesmithError, DefinitionError
 from .nurbs_objects import PROPERTY_KEY, remove_object, surface_to_object, write_surface
+from .scene_guard import unchanged_on_refusal
 
 PRESET_DIR = pathlib.Path(__file__).resolve().parent.parent / "data" / "impellers"
 ROOT_KEY = "bladesmith_impeller_root"
@@ -140,6 +141,7 @@ class BLADESMITH_OT_add_impeller(bpy.types.Operator):
     def poll(cls, context):
         return context.mode == "OBJECT"
 
+    @unchanged_on_refusal
     def execute(self, context):
         try:
             definition = load_definition(self.definition, self.preset)

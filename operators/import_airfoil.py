@@ -20,6 +20,7 @@ from ..geometry.errors import BladesmithError
 from ..geometry.nurbs import interpolate
 from ..geometry.sections.airfoil_file import read_airfoil
 from .nurbs_objects import curve_to_object
+from .scene_guard import unchanged_on_refusal
 
 #: Custom property holding the tabulated, unit-chord airfoil on imported objects.
 AIRFOIL_KEY = "bladesmith_airfoil"
@@ -80,6 +81,7 @@ class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper):
         default=False,
     )
 
+    @unchanged_on_refusal
     def execute(self, context):
         try:
             airfoil = read_airfoil(self.filepath)

@@ -62,6 +62,7 @@ from ..geometry.propeller.display import DISPLAY_TOLERANCE_FRACTION, blade_displ
 from .progress import progress_callback
 from .nurbs_objects import PROPERTY_KEY, remove_object, write_surface
 from .values import typed
+from .scene_guard import unchanged_on_refusal
 
 #: The extension package (``bladesmith`` from a checkout, ``bl_ext.<repo>.bladesmith``
 #: when installed).
@@ -465,6 +466,27 @@ def smoothing_summary(smoothed) -> str:
     return text
 
 
+def tolerance_misses(result: DisplayResult) -> list[str]:
+    """A sentence with the figures for every requested tolerance or bound the shown
+    blade does not meet (empty when all are met): the operator warns with them rather
+    than reporting a silent success."""
+    out = []
+    if result.deviation is not None and result.deviation > result.tolerance:
+        out.append(f"the displayed blade deviates {result.deviation:.3g} m from the model, more than the display "
+                   f"tolerance {result.tolerance:.3g} m")
+    report = result.smoothing.report if result.smoothing is not None else {}
+    dev = report.get("deviation_m")
+    if dev is not None:
+        if dev["max_outside"] > report["tolerance_m"]:
+            out.append(f"the smoothed blade deviates {dev['max_outside']:.3g} m from the unsmoothed one outside the "
+                       f"smoothing zone, more than the tolerance {report['tolerance_m']:.3g} m")
+        bound = report.get("deviation_bound_inside_m")
+        if bound is not None and dev["max_inside"] > bound:
+            out.append(f"inside the smoothing zone it deviates {dev['max_inside']:.3g} m, more than the bound "
+                       f"{bound:.3g} m")
+    return out
+
+
 # -- writing surfaces into objects ----------------------------------------------------------
 def _part(obj) -> tuple[str, int, int] | None:
     if obj.get(PART_KEY) is None:
@@ -741,6 +763,7 @@ class BLADESMITH_OT_add_propeller(bpy.types.Operator):
             return self.preset
         return self.preset_choice
 
+    @unchanged_on_refusal
     def execute(self, context):
         wm = context.window_manager
         wm.progress_begin(0, 100)
@@ -767,6 +790,8 @@ class BLADESMITH_OT_add_propeller(bpy.types.Operator):
         finally:
             wm.progress_end()
         self.report({"INFO"}, f"{root.name}: {root.bladesmith_propeller.status}")
+        for miss in tolerance_misses(result):
+            self.report({"WARNING"}, f"{root.name}: {miss}")
         return {"FINISHED"}
 
 

@@ -24,7 +24,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from ..geometry.errors import BladesmithError, GeometryError
+from ..geometry.errors import BladesmithError, DefinitionError, GeometryError
 from ..geometry.fairing import (
     PolynomialDistribution,
     SmoothingSettings,
@@ -38,6 +38,7 @@ from ..geometry.fairing.curvature import span_samples
 from ..geometry.nurbs import BSplineCurve
 from .import_airfoil import stored_airfoil
 from .nurbs_objects import curve_to_object, object_to_geometry, remove_object, stored_geometry
+from .scene_guard import check_output_file, unchanged_on_refusal
 
 #: Points farther than this fraction of the curve's size from its best-fit plane make
 #: the curve non-planar (float32 coordinates leave ~1e-7 of noise).
@@ -191,10 +192,12 @@ class BLADESMITH_OT_smooth_curve(bpy.types.Operator):
     max_iterations: IntProperty(name="ntrial", description="Maximum Newton/secant iterations (jobcard ntrial)", default=10, min=1)
     tolx: FloatProperty(name="tolx", description="Tolerance on the sum of displacements", default=1e-10, min=0.0, precision=12)
     tolf: FloatProperty(name="tolf", description="Tolerance on the sum of curvature residuals", default=1e-9, min=0.0, precision=12)
-    smoothing_type: EnumProperty(
+    # an integer, as the jobcard's smttype (1: smooth the curvature everywhere, 2: keep the
+    # largest curvature, the airfoil LE); other values are refused by SmoothingSettings
+    smoothing_type: IntProperty(
         name="Smoothing type",
-        items=[("1", "1: smooth all", "Smooth the curvature everywhere"), ("2", "2: keep maximum", "Keep the largest curvature (airfoil LE)")],
-        default="2",
+        description="Jobcard smttype: 1 smooths the curvature everywhere, 2 keeps the largest curvature (airfoil LE)",
+        default=2, soft_min=1, soft_max=2,
     )
     smoother: EnumProperty(
         name="Smoother",
@@ -234,14 +237,19 @@ class BLADESMITH_OT_smooth_curve(bpy.types.Operator):
             smoothing_weight=self.smoothing_weight,
         )
 
+    @unchanged_on_refusal
     def execute(self, context):
         obj = context.active_object
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
+            path = check_output_file(self.filepath) if self.filepath else ""
             result, origin, axes = self._smooth(obj, lambda done, total: wm.progress_update(int(90 * done / max(total, 1))))
-            if self.filepath:
-                write_points(bpy.path.abspath(self.filepath), result.points)
+            if path:
+                try:
+                    write_points(path, result.points)
+                except OSError as exc:
+                    raise DefinitionError(f"cannot write {path!r}: {exc.strerror or exc}", field="filepath") from None
             made = build_objects(obj, result, origin, axes, self.plot_height, self.comb_length, self.deviation_gain) if self.make_plots else None
             if made is None:
                 collection = obj.users_collection[0] if obj.users_collection else context.scene.collection

@@ -58,6 +58,7 @@ from . import nurbs_objects
 from .progress import progress_callback
 from .nurbs_objects import remove_object, write_curve, write_surface
 from .values import typed
+from .scene_guard import unchanged_on_refusal
 
 #: Custom property naming a child's part (a key of BladeMolds.surfaces / parting_lines, or "single").
 PART_KEY = "bladesmith_mold_part"
@@ -412,6 +413,7 @@ class BLADESMITH_OT_add_wind_blade(bpy.types.Operator):
             return self.preset
         return self.preset_choice
 
+    @unchanged_on_refusal
     def execute(self, context):
         wm = context.window_manager
         wm.progress_begin(0, 100)

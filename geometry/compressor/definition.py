@@ -135,10 +135,10 @@ class ChannelDefinition:
         check_count(len(raw_degrees), MAX_CHANNEL_PATCHES, "MAX_CHANNEL_PATCHES", path, "channel.degrees", "patches")
         degrees = []
         for j, d in enumerate(raw_degrees):
-            d = number(d, path, f"channel.degrees[{j}]", integer=True)
+            d = number(d, path, "channel.degrees", integer=True, entry=f"patch {j}: ")
             if d not in (1, 4):
                 raise DefinitionError(f"patch {j}: degree must be 1 (straight) or 4 (bend), got {d}", path=path,
-                                      field=f"channel.degrees[{j}]")
+                                      field="channel.degrees")
             degrees.append(d)
         degrees = tuple(degrees)
         n = len(degrees)
@@ -157,17 +157,18 @@ class ChannelDefinition:
                 if a == "auto":
                     angles.append(math.nan)
                 elif isinstance(a, (int, float)) and not isinstance(a, bool):
-                    angles.append(number(a, path, f"channel.{w}_angle[{i}]", lo=-MAX_ANGLE_DEG, hi=MAX_ANGLE_DEG))
+                    angles.append(number(a, path, f"channel.{w}_angle", lo=-MAX_ANGLE_DEG, hi=MAX_ANGLE_DEG,
+                                         entry=f"corner {i}: "))
                 else:
-                    raise DefinitionError(f"expected a number or \"auto\", got {a!r}", path=path,
-                                          field=f"channel.{w}_angle[{i}]")
+                    raise DefinitionError(f"corner {i}: expected a number or \"auto\", got {a!r}", path=path,
+                                          field=f"channel.{w}_angle")
             values[f"{w}_angle"] = tuple(angles)
             fr = data.get(f"{w}_fractions", [[0.5, 0.5]] * n)
             if not isinstance(fr, list) or len(fr) != n or not all(isinstance(q, list) and len(q) == 2 for q in fr):
                 raise DefinitionError(f"expected {n} pairs [fa, fb], got {fr!r}", path=path,
                                       field=f"channel.{w}_fractions")
-            fr = np.array([[number(v, path, f"channel.{w}_fractions[{j}]", lo=0.0, hi=1.0, lo_open=True,
-                                   hi_open=True) for v in q] for j, q in enumerate(fr)], dtype=float).reshape(n, 2)
+            fr = np.array([[number(v, path, f"channel.{w}_fractions", lo=0.0, hi=1.0, lo_open=True, hi_open=True,
+                                   entry=f"pair {j}: ") for v in q] for j, q in enumerate(fr)], dtype=float).reshape(n, 2)
             if fr.shape != (n, 2):
                 raise DefinitionError(f"expected {n} pairs, got shape {fr.shape}", path=path, field=f"channel.{w}_fractions")
             values[f"{w}_fractions"] = tuple(map(tuple, fr.tolist()))

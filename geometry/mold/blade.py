@@ -280,13 +280,15 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
             for k in np.flatnonzero(worst > tol):
                 worst[k] = section_deviation(splits[k], fits[k])
             ok = bool(np.all(worst <= tol))
-        except BladesmithError:
+        except BladesmithError as exc:
             if n == int(control_points or defn.control_points):
                 raise
-            ok, fits = False, None
+            ok, fits, failure = False, None, exc
         if ok or not adapt or n + CONTROL_POINT_STEP > MAX_CONTROL_POINTS:
             if fits is None:
-                raise GeometryError(f"no fit with {n} control points per half")
+                # name the station and the cause (the fit's own message)
+                raise GeometryError(f"no fit with {n} control points per half (raised up to MAX_CONTROL_POINTS = "
+                                    f"{MAX_CONTROL_POINTS}): {failure}") from failure
             break
         n += CONTROL_POINT_STEP
     if not ok:

@@ -200,6 +200,9 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
         if not 0 < vals["r"] <= MAX_LENGTH:
             raise DefinitionError(f"station {k}: r must lie in (0, MAX_LENGTH = {MAX_LENGTH:g}] m, got {vals['r']!r}",
                                   path=path, field=f"stations.r[{k}]")
+        if vals["chord"] <= 0:
+            raise DefinitionError(f"station {k}: chord must be > 0, got {vals['chord']!r}", path=path,
+                                  field=f"stations.chord[{k}]")
         if not MIN_LENGTH <= vals["chord"] <= MAX_LENGTH:
             raise DefinitionError(f"station {k}: chord must lie in [MIN_LENGTH = {MIN_LENGTH:g}, MAX_LENGTH = "
                                   f"{MAX_LENGTH:g}] m, got {vals['chord']!r}", path=path, field=f"stations.chord[{k}]")

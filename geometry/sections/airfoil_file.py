@@ -141,7 +141,7 @@ def _check_duplicates(points: np.ndarray, lines: np.ndarray, path: pathlib.Path)
         i = bad[0]
         raise DefinitionError(
             f"line {lines[i + 1]}: point {i + 1} ({points[i + 1, 0]:g}, {points[i + 1, 1]:g}) duplicates "
-            f"point {i} on line {lines[i]}",
+            f"the point on line {lines[i]} (point {i})",
             path=str(path),
         )
 
