@@ -44,6 +44,9 @@ from .scene_guard import check_output_file, unchanged_on_refusal
 #: the curve non-planar (float32 coordinates leave ~1e-7 of noise).
 PLANAR_TOL = 1e-5
 
+#: Fewest control points of a curve to smooth (the cubic through them needs 4).
+MIN_CURVE_POINTS = 4
+
 #: Samples per knot span used to read a non-polyline curve as airfoil data.
 AIRFOIL_SAMPLES_PER_SPAN = 2
 
@@ -82,6 +85,9 @@ def read_planar_curve(obj) -> tuple[BSplineCurve, np.ndarray, np.ndarray]:
     curve = curves[0]
     if not isinstance(curve, BSplineCurve):
         raise GeometryError(f"{obj.name}: expected a curve, got a surface")
+    if len(curve.control_points) < MIN_CURVE_POINTS:
+        raise GeometryError(f"{obj.name}: the curve has {len(curve.control_points)} points; smoothing needs at "
+                            f"least {MIN_CURVE_POINTS}")
     if curve.dim == 2:
         return curve, np.zeros(3), np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     P = curve.control_points[:, :3]
