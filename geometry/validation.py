@@ -64,6 +64,8 @@ def read_bytes(path, *, what: str = "file", source=None, field: str | None = Non
         raise DefinitionError(f"{prefix}is a directory, not a {what}", **where) from None
     except OSError as exc:
         raise DefinitionError(f"{prefix}cannot read ({exc.strerror or exc})", **where) from None
+    except ValueError as exc:  # a NUL character in the name
+        raise DefinitionError(f"{prefix or what + ' '}has an invalid name ({exc})", **where) from None
 
 
 def read_text(path, *, what: str = "file", source=None, field: str | None = None) -> str:

@@ -86,6 +86,9 @@ MAX_BLADE_PATCHES = 50
 MAX_COEFFICIENTS = 30
 #: |wall angle| and |lean| (degrees).
 MAX_ANGLE_DEG = 180.0
+#: The fractions placing P_1 and P_3 of a bend lie in [MIN_FRACTION, 1 - MIN_FRACTION]:
+#: nearer the ends, a leg of the bend's polygon degenerates (a zero end tangent).
+MIN_FRACTION = 0.05
 #: Rounded-edge ellipse semi-axes ratio.
 MAX_EDGE_RATIO = 20.0
 
@@ -167,7 +170,7 @@ class ChannelDefinition:
             if not isinstance(fr, list) or len(fr) != n or not all(isinstance(q, list) and len(q) == 2 for q in fr):
                 raise DefinitionError(f"expected {n} pairs [fa, fb], got {fr!r}", path=path,
                                       field=f"channel.{w}_fractions")
-            fr = np.array([[number(v, path, f"channel.{w}_fractions", lo=0.0, hi=1.0, lo_open=True, hi_open=True,
+            fr = np.array([[number(v, path, f"channel.{w}_fractions", lo=MIN_FRACTION, hi=1.0 - MIN_FRACTION,
                                    entry=f"pair {j}: ") for v in q] for j, q in enumerate(fr)], dtype=float).reshape(n, 2)
             if fr.shape != (n, 2):
                 raise DefinitionError(f"expected {n} pairs, got shape {fr.shape}", path=path, field=f"channel.{w}_fractions")

@@ -75,6 +75,8 @@ MAX_STATIONS = 300
 #: Control points per half and section (the fit raises the count up to
 #: mold.blade.MAX_CONTROL_POINTS; a start above it is refused here).
 MAX_START_CONTROL_POINTS = 60
+#: Fewest stations from first_aerodynamic_station on (the skinning is cubic across the span).
+MIN_AERODYNAMIC_STATIONS = 4
 #: |twist| (degrees).
 MAX_TWIST_DEG = 180.0
 #: The smallest fitting tolerance (fraction of the chord): below, float64 rounding of the
@@ -248,6 +250,11 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
     if isinstance(first, bool) or not isinstance(first, int) or not 0 <= first <= count - 2:
         raise DefinitionError(f"expected an integer in [0, {count - 2}], got {first!r}", path=path,
                               field="first_aerodynamic_station")
+    if count - first < MIN_AERODYNAMIC_STATIONS:
+        raise DefinitionError(
+            f"the aerodynamic zone (stations {first} to {count - 1}) has {count - first} stations; skinning them "
+            f"(degree 3 across the span) needs at least {MIN_AERODYNAMIC_STATIONS}", path=path,
+            field="first_aerodynamic_station" if first else "stations.r")
     n = data.get("control_points", DEFAULT_CONTROL_POINTS)
     if isinstance(n, bool) or not isinstance(n, int) or n < 5:
         raise DefinitionError(f"expected an integer >= 5, got {n!r}", path=path, field="control_points")
