@@ -57,7 +57,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import DefinitionError, GeometryError
-from ..validation import MAX_LENGTH, check_count, check_keys, number, number_list, read_toml, string, table
+from ..validation import MAX_LENGTH, MIN_LENGTH, check_count, check_keys, number, number_list, read_toml, string, table
 from .blade import MAX_BETA_DEG, BladeSurfaces, WallBlade, WallCamber, build_blade
 from .channel import MeridionalChannel, WallSkeleton, channel_from_skeleton
 from .standardisation import Standardisation
@@ -175,6 +175,10 @@ class ChannelDefinition:
             if fr.shape != (n, 2):
                 raise DefinitionError(f"expected {n} pairs, got shape {fr.shape}", path=path, field=f"channel.{w}_fractions")
             values[f"{w}_fractions"] = tuple(map(tuple, fr.tolist()))
+        size = max(np.ptp(values[f"{w}_{c}"] + values[f"{v}_{c}"]) for w in WALLS for v in WALLS for c in "zr")
+        if size < MIN_LENGTH:
+            raise DefinitionError(f"the channel spans {size!r} m, less than MIN_LENGTH = {MIN_LENGTH:g} m (the "
+                                  "float32 display would lose it)", path=path, field="channel.hub_z")
         return cls(**values)
 
     def to_dict(self) -> dict:

@@ -180,6 +180,15 @@ def test_missed_propeller_tolerance_is_reported_with_figures(scene):
     assert prop_op.tolerance_misses(result) == []
 
 
+def test_add_propeller_warns_when_the_tolerance_is_missed(scene, capfd):
+    """tolerance=1e-7 D: FINISHED, with a WARNING report giving the deviation and the
+    tolerance (Blender prints reports of background runs)."""
+    assert bpy.ops.bladesmith.add_propeller(preset="DTMB4119", smooth_tip=True, tolerance=1e-7) == {"FINISHED"}
+    out = capfd.readouterr()
+    text = out.out + out.err
+    assert "Warning" in text and "more than the tolerance 3.05e-08 m" in text, text[-2000:]
+
+
 # -- airfoils -----------------------------------------------------------------------------------
 def test_import_airfoil_name_and_refusals(scene, tmp_path):
     assert bpy.ops.bladesmith.import_airfoil(filepath=str(SHARED / "airfoils" / "s823.dat")) == {"FINISHED"}

@@ -363,3 +363,10 @@ def test_presets_still_load():
         for path in sorted((ROOT / "data" / folder).glob("*.toml")):
             load(path)
     copy.deepcopy(_data(IMPELLER))
+
+
+def test_impeller_too_small_for_float32_display():
+    data = _data(IMPELLER)
+    for key in ("hub_z", "hub_r", "shroud_z", "shroud_r"):
+        data["channel"][key] = [v * 1e-9 for v in data["channel"][key]]
+    _refused(lambda: ImpellerDefinition.from_dict(data, "imp.toml"), "channel.hub_z", "MIN_LENGTH")
