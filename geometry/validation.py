@@ -52,16 +52,18 @@ def read_bytes(path, *, what: str = "file", source=None, field: str | None = Non
     try:
         size = os.stat(path).st_size
         if path.is_dir():
-            raise DefinitionError(f"{prefix}is a directory, not a {what}", **where)
+            raise DefinitionError(f"{prefix}is a directory, not a file", **where)
         if size > MAX_FILE_BYTES:
             raise DefinitionError(f"{prefix}{size} bytes is more than the limit MAX_FILE_BYTES = {MAX_FILE_BYTES}",
                                   **where)
         with open(path, "rb") as fh:
             return fh.read(MAX_FILE_BYTES + 1)
+    except DefinitionError:
+        raise
     except FileNotFoundError:
         raise DefinitionError(f"{prefix or what + ' '}not found", **where) from None
     except IsADirectoryError:
-        raise DefinitionError(f"{prefix}is a directory, not a {what}", **where) from None
+        raise DefinitionError(f"{prefix}is a directory, not a file", **where) from None
     except OSError as exc:
         raise DefinitionError(f"{prefix}cannot read ({exc.strerror or exc})", **where) from None
     except ValueError as exc:  # a NUL character in the name
