@@ -42,7 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import BladesmithError, DefinitionError
-from ..validation import MAX_LENGTH, MIN_LENGTH, check_count, check_keys, number, read_toml, string, table
+from ..validation import MAX_LENGTH, MIN_LENGTH, check_count, check_keys, read_toml, string
 from ..sections.airfoil_file import Airfoil, read_airfoil, smoothed_airfoil
 from ..sections.shape import DEFAULT_SMOOTH_PASSES, check_smooth_passes
 

@@ -52,7 +52,6 @@ import io
 import math
 import os
 import pathlib
-import tomllib
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
