@@ -38,6 +38,17 @@ def measuring() -> bool:
     return "BLADESMITH_PROPERTY_EXAMPLES" in os.environ
 
 
+def save_counts(level: str, counts: dict) -> None:
+    """With BLADESMITH_PROPERTY_REPORT=DIR, keep the running counts in DIR/<level>.json
+    (so a long measured run can be read while it goes)."""
+    folder = os.environ.get("BLADESMITH_PROPERTY_REPORT")
+    if folder:
+        import json
+
+        with open(os.path.join(folder, f"{level}-{os.getpid()}.json"), "w") as fh:
+            json.dump(counts, fh)
+
+
 WILD = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
     st.integers(min_value=-(2**63), max_value=2**63 - 1),

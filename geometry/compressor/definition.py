@@ -467,7 +467,16 @@ class ImpellerDefinition:
                     raise DefinitionError(f"thickness must be >= 0, got {th.min()}", path=p, field=f"splitter.thickness_{w}")
 
     def build(self) -> ImpellerModel:
-        """Validate and build the float64 model (channel, blade, splitter)."""
+        """Validate and build the float64 model (channel, blade, splitter); a refusal names
+        the definition's file."""
+        try:
+            return self._build()
+        except DefinitionError as exc:
+            if exc.path or not self.path:
+                raise
+            raise exc.with_path(self.path) from None
+
+    def _build(self) -> ImpellerModel:
         channel = self.channel.build(self.path)
         self._check_blade(channel.count)
         b = self.blade

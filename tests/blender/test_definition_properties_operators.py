@@ -89,6 +89,7 @@ def _run(kind, folder, source, data, log, call):
     finally:
         elapsed = time.perf_counter() - start
         COUNTS[kind]["max_seconds"] = max(COUNTS[kind]["max_seconds"], elapsed)
+    dm.save_counts("operators", COUNTS)
     if dm.measuring():
         assert elapsed <= CASE_SECONDS
 

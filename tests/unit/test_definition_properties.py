@@ -102,6 +102,7 @@ def check_case(kind: str, build, data, log, path):
         elapsed = time.perf_counter() - start
         counts["max_seconds"] = max(counts["max_seconds"], elapsed)
     counts[outcome] += 1
+    dm.save_counts("unit", COUNTS)
     if dm.measuring():
         assert elapsed <= CASE_SECONDS, (elapsed, log)
 
