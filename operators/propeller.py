@@ -54,7 +54,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from ..geometry.errors import BladesmithError, DefinitionError
+from ..geometry.errors import BladesmithError, DefinitionError, GeometryError
 from ..geometry.nurbs import BSplineSurface
 from ..geometry.propeller import BladeSurface, Hub, Propeller, PropellerModel, dumps_toml, smooth_blade
 from ..geometry.propeller.definition import RADIAL_FIELDS
@@ -445,7 +445,11 @@ def compute_display(propeller: Propeller, *, display_tolerance: float, smooth_ti
         smoothed = smooth_blade(model, settings, progress=progress, measure=measure)
         surfaces, deviation = list(smoothed.surfaces), None
     else:
-        display = blade_display_surface(model.blade, tolerance, knots=knots, progress=progress)
+        try:
+            display = blade_display_surface(model.blade, tolerance, knots=knots, progress=progress)
+        except GeometryError as exc:  # name the definition and the setting that cannot be met
+            raise DefinitionError(f"{exc} (display_tolerance = {display_tolerance:g} D)", path=propeller.source,
+                                  field="display_tolerance") from None
         surfaces, deviation = [display.surface], display.max_deviation
     return DisplayResult(propeller, model, surfaces, hub_surface(model.hub), deviation, tolerance, smooth_tip, smoothed)
 
