@@ -48,7 +48,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from ..geometry.errors import BladesmithError, DefinitionError
+from ..geometry.errors import BladesmithError, DefinitionError, GeometryError
 from ..geometry.mold import BladeDefinition, BladeMolds, blade_from_dict, build_blade, load_blade, preset_files
 from ..iges.mold import write_molds
 from ..geometry.nurbs import BSplineCurve
@@ -422,7 +422,10 @@ class BLADESMITH_OT_add_wind_blade(bpy.types.Operator):
             tolerance = typed(self.tolerance)  # the float32 property as typed
             check_fit_settings(self.control_points, tolerance)
             defn = _override(load_definition(self.definition, self._preset_name()), self.control_points, tolerance)
-            molds = compute_molds(defn, fairness=self.fairness, progress=progress_callback(wm))
+            try:
+                molds = compute_molds(defn, fairness=self.fairness, progress=progress_callback(wm))
+            except GeometryError as exc:  # the station and cause are in the message; name the file
+                raise DefinitionError(str(exc), path=defn.path or None) from None
             root = create_wind_blade(context, molds, self.mold_halves, time.perf_counter() - start)
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
