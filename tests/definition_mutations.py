@@ -22,6 +22,7 @@ from __future__ import annotations
 import copy
 import math
 import os
+import re
 
 from hypothesis import strategies as st
 
@@ -153,9 +154,17 @@ def mutated(draw, base: dict):
     return data, log
 
 
+def _named(name: str, message: str) -> bool:
+    """``name`` appears as a field: quoted, dotted or indexed, or (a long or compound key
+    such as mold_direction) as a whole word."""
+    if f"'{name}" in message or f".{name}" in message or f"{name}'" in message or f"{name}[" in message:
+        return True
+    return ("_" in name or len(name) >= 6) and re.search(rf"\b{re.escape(name)}\b", message) is not None
+
+
 def names_a_field(message: str, log, vocabulary) -> bool:
     """The refusal names a mutated key, or (for an inconsistency) a key of the format."""
     touched = set().union(*(n for _, _, n in log)) if log else set()
-    if any(f"'{n}" in message or f".{n}" in message or f"{n}'" in message or f"{n}[" in message for n in touched):
+    if any(_named(n, message) for n in touched):
         return True
-    return any(f"'{n}" in message or f".{n}" in message for n in vocabulary)
+    return any(_named(n, message) for n in vocabulary)
