@@ -20,6 +20,7 @@ import difflib
 import math
 import os
 import pathlib
+import stat
 import tomllib
 
 from .errors import DefinitionError
@@ -50,9 +51,12 @@ def read_bytes(path, *, what: str = "file", source=None, field: str | None = Non
     where = dict(path=str(source), field=field) if source is not None else dict(path=str(path), field=field)
     prefix = "" if source is None else f"{what} {str(path)!r}: "
     try:
-        size = os.stat(path).st_size
-        if path.is_dir():
+        info = os.stat(path)
+        size = info.st_size
+        if stat.S_ISDIR(info.st_mode):
             raise DefinitionError(f"{prefix}is a directory, not a file", **where)
+        if not stat.S_ISREG(info.st_mode):  # a FIFO or device would block or never end
+            raise DefinitionError(f"{prefix}is not a regular file", **where)
         if size > MAX_FILE_BYTES:
             raise DefinitionError(f"{prefix}{size} bytes is more than the limit MAX_FILE_BYTES = {MAX_FILE_BYTES}",
                                   **where)

@@ -370,3 +370,13 @@ def test_impeller_too_small_for_float32_display():
     for key in ("hub_z", "hub_r", "shroud_z", "shroud_r"):
         data["channel"][key] = [v * 1e-9 for v in data["channel"][key]]
     _refused(lambda: ImpellerDefinition.from_dict(data, "imp.toml"), "channel.hub_z", "MIN_LENGTH")
+
+
+@pytest.mark.parametrize("kind", sorted(LOADERS))
+def test_fifo_as_definition_is_refused_without_blocking(tmp_path, kind):
+    import os
+
+    fifo = tmp_path / "pipe.toml"
+    os.mkfifo(fifo)
+    with pytest.raises(DefinitionError, match=r"pipe\.toml.*not a regular file"):
+        LOADERS[kind](fifo)
