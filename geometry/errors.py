@@ -19,6 +19,7 @@ class DefinitionError(BladesmithError):
     def __init__(self, message: str, *, path: str | None = None, field: str | None = None):
         self.path = path
         self.field = field
+        self.message = message
         parts = []
         if path:
             parts.append(str(path))
@@ -26,6 +27,11 @@ class DefinitionError(BladesmithError):
             parts.append(f"field '{field}'")
         prefix = ": ".join(parts)
         super().__init__(f"{prefix}: {message}" if prefix else message)
+
+
+    def with_path(self, path) -> "DefinitionError":
+        """The same refusal naming ``path`` (for checks made where the file is not known)."""
+        return DefinitionError(self.message, path=self.path or path, field=self.field)
 
 
 class GeometryError(BladesmithError):

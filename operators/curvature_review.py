@@ -68,6 +68,7 @@ from ..geometry.fairing.surface_curvature import (
 )
 from ..geometry.nurbs import BSplineCurve, BSplineSurface
 from .nurbs_objects import object_to_geometry, remove_object
+from .scene_guard import check_output_file, unchanged_on_refusal
 
 REVIEW_COLLECTION = "Bladesmith Review"
 #: Custom property on every review object: {"role": ..., "source": ..., "index": ...}.
@@ -1256,6 +1257,7 @@ class BLADESMITH_OT_curvature_review(bpy.types.Operator):
     def poll(cls, context):
         return any(o.type in {"CURVE", "SURFACE", "EMPTY"} for o in context.selected_objects)
 
+    @unchanged_on_refusal
     def execute(self, context):
         options = ReviewOptions(
             quantity=self.quantity, percentile=self.percentile, limit=self.limit,
@@ -1267,10 +1269,21 @@ class BLADESMITH_OT_curvature_review(bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 2)
         try:
+            path = ""
+            if self.filepath:
+                # refuse before the review rewrites anything: an image needs surface maps and
+                # a writable folder
+                path = check_output_file(self.filepath)
+                if not any(o.type == "SURFACE" for o in review_sources(list(context.selected_objects))):
+                    raise GeometryError(f"cannot render {path!r}: the selection has no surfaces, so the review "
+                                        "has no curvature maps to show (leave filepath empty to review curves)")
             result = review_objects(context.scene, list(context.selected_objects), options)
             wm.progress_update(1)
-            if self.filepath:
-                render_review_image([], bpy.path.abspath(self.filepath), scene=context.scene, review=False)
+            if path:
+                try:
+                    render_review_image([], path, scene=context.scene, review=False)
+                except OSError as exc:
+                    raise GeometryError(f"cannot write the review image {path!r}: {exc.strerror or exc}") from None
         except BladesmithError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

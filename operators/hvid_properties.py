@@ -57,10 +57,12 @@ class HvidProperties:
     max_iterations: IntProperty(name="ntrial", description="Maximum Newton/secant iterations (jobcard ntrial)", default=10, min=1)
     tolx: FloatProperty(name="tolx", description="Tolerance on the sum of displacements", default=1e-10, min=0.0, precision=12)
     tolf: FloatProperty(name="tolf", description="Tolerance on the sum of curvature residuals", default=1e-9, min=0.0, precision=12)
-    smoothing_type: EnumProperty(
+    # an integer, as the jobcard's smttype (1: smooth the curvature everywhere, 2: keep the
+    # largest curvature, the airfoil LE); other values are refused by SmoothingSettings
+    smoothing_type: IntProperty(
         name="Smoothing type",
-        items=[("1", "1: smooth all", "Smooth the curvature everywhere"), ("2", "2: keep maximum", "Keep the largest curvature (airfoil LE)")],
-        default="2",
+        description="Jobcard smttype: 1 smooths the curvature everywhere, 2 keeps the largest curvature (airfoil LE)",
+        default=2, soft_min=1, soft_max=2,
     )
     smoother: EnumProperty(
         name="Smoother",

@@ -23,6 +23,7 @@ from ..geometry.compressor import ImpellerDefinition, blade_net, distribution, d
 from ..geometry.compressor.export import construction_summary, impeller_surfaces
 from ..geometry.errors import BladesmithError, DefinitionError
 from .nurbs_objects import PROPERTY_KEY, remove_object, surface_to_object, write_surface
+from .scene_guard import unchanged_on_refusal
 
 PRESET_DIR = pathlib.Path(__file__).resolve().parent.parent / "data" / "impellers"
 ROOT_KEY = "bladesmith_impeller_root"
@@ -160,6 +161,7 @@ class BLADESMITH_OT_add_impeller(bpy.types.Operator):
             return self.preset
         return self.preset_choice
 
+    @unchanged_on_refusal
     def execute(self, context):
         try:
             definition = load_definition(self.definition, self._preset_name())

@@ -21,6 +21,7 @@ from ..geometry.nurbs import interpolate
 from ..geometry.sections.airfoil_file import read_airfoil
 from .hvid_properties import JOBCARD, HvidProperties, draw_jobcard
 from .nurbs_objects import curve_to_object, remove_object
+from .scene_guard import unchanged_on_refusal
 
 #: Custom property holding the tabulated, unit-chord airfoil on imported objects.
 AIRFOIL_KEY = "bladesmith_airfoil"
@@ -81,20 +82,9 @@ class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper, HvidPropert
         default=False,
     )
 
-    smooth: BoolProperty(
-        name="Smooth (Hvid)",
-        description="Smooth the imported airfoil with Hvid's smoothfoil (the settings below), as Smooth Curve (Hvid) does",
-        default=False,
-    )
-
-    def draw(self, context):
-        layout = self.layout
-        layout.prop(self, "chord")
-        layout.prop(self, "as_polyline")
-        layout.prop(self, "smooth")
-        if self.smooth:
-            draw_jobcard(layout.box(), self, "AIRFOIL", show_kind=False)
-
+from .hvid_properties import JOBCARD, HvidProperties, draw_jobcard
+from .nurbs_objects import curve_to_object, remove_object
+from .scene_guard import unchanged_on_refusal
     def execute(self, context):
         try:
             airfoil = read_airfoil(self.filepath)
@@ -121,7 +111,7 @@ class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper, HvidPropert
         self.report(
             {"INFO"},
             f"Imported {airfoil.name!r} ({airfoil.format}, {len(airfoil.outline)} points, "
-            f"{'sharp' if te == 0 else f'blunt {te:.4g} c'} trailing edge)",
+            f"{'sharp' if airfoil.sharp_trailing_edge else f'blunt {te:.4g} c'} trailing edge)",
         )
         return {"FINISHED"}
 

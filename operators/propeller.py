@@ -54,7 +54,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from ..geometry.errors import BladesmithError, DefinitionError
+from ..geometry.errors import BladesmithError, DefinitionError, GeometryError
 from ..geometry.nurbs import BSplineSurface
 from ..geometry.propeller import BladeSurface, Hub, Propeller, PropellerModel, dumps_toml, smooth_blade
 from ..geometry.propeller.definition import RADIAL_FIELDS
@@ -62,6 +62,7 @@ from ..geometry.propeller.display import DISPLAY_TOLERANCE_FRACTION, blade_displ
 from .progress import progress_callback
 from .nurbs_objects import PROPERTY_KEY, remove_object, write_surface
 from .values import typed
+from .scene_guard import unchanged_on_refusal
 
 #: The extension package (``bladesmith`` from a checkout, ``bl_ext.<repo>.bladesmith``
 #: when installed).
@@ -444,7 +445,11 @@ def compute_display(propeller: Propeller, *, display_tolerance: float, smooth_ti
         smoothed = smooth_blade(model, settings, progress=progress, measure=measure)
         surfaces, deviation = list(smoothed.surfaces), None
     else:
-        display = blade_display_surface(model.blade, tolerance, knots=knots, progress=progress)
+        try:
+            display = blade_display_surface(model.blade, tolerance, knots=knots, progress=progress)
+        except GeometryError as exc:  # name the definition and the setting that cannot be met
+            raise DefinitionError(f"{exc} (display_tolerance = {display_tolerance:g} D)", path=propeller.source,
+                                  field="display_tolerance") from None
         surfaces, deviation = [display.surface], display.max_deviation
     return DisplayResult(propeller, model, surfaces, hub_surface(model.hub), deviation, tolerance, smooth_tip, smoothed)
 
@@ -467,6 +472,27 @@ def smoothing_summary(smoothed) -> str:
         text += (f"; tip irregularity {ti['unsmoothed']:.4g} unsmoothed -> {ti['smoothed']:.4g} smoothed "
                  f"(x{ti['ratio']:.3f}, excess curvature variation x R over {ti['curves']} curves)")
     return text
+
+
+def tolerance_misses(result: DisplayResult) -> list[str]:
+    """A sentence with the figures for every requested tolerance or bound the shown
+    blade does not meet (empty when all are met): the operator warns with them rather
+    than reporting a silent success."""
+    out = []
+    if result.deviation is not None and result.deviation > result.tolerance:
+        out.append(f"the displayed blade deviates {result.deviation:.3g} m from the model, more than the display "
+                   f"tolerance {result.tolerance:.3g} m")
+    report = result.smoothing.report if result.smoothing is not None else {}
+    dev = report.get("deviation_m")
+    if dev is not None:
+        if dev["max_outside"] > report["tolerance_m"]:
+            out.append(f"the smoothed blade deviates {dev['max_outside']:.3g} m from the unsmoothed one outside the "
+                       f"smoothing zone, more than the tolerance {report['tolerance_m']:.3g} m")
+        bound = report.get("deviation_bound_inside_m")
+        if bound is not None and dev["max_inside"] > bound:
+            out.append(f"inside the smoothing zone it deviates {dev['max_inside']:.3g} m, more than the bound "
+                       f"{bound:.3g} m")
+    return out
 
 
 # -- writing surfaces into objects ----------------------------------------------------------
@@ -745,6 +771,7 @@ class BLADESMITH_OT_add_propeller(bpy.types.Operator):
             return self.preset
         return self.preset_choice
 
+    @unchanged_on_refusal
     def execute(self, context):
         wm = context.window_manager
         wm.progress_begin(0, 100)
@@ -774,6 +801,8 @@ class BLADESMITH_OT_add_propeller(bpy.types.Operator):
         if result.smoothing is not None:
             for warning in result.smoothing.report.get("warnings", []):
                 self.report({"WARNING"}, warning)
+        for miss in tolerance_misses(result):
+            self.report({"WARNING"}, f"{root.name}: {miss}")
         return {"FINISHED"}
 
 

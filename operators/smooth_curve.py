@@ -26,7 +26,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, FloatProperty, StringProperty
 
-from ..geometry.errors import BladesmithError, GeometryError
+from ..geometry.errors import BladesmithError, DefinitionError, GeometryError
 from ..geometry.fairing import (
     curvature_comb,
     curvature_plot,
@@ -40,10 +40,14 @@ from ..geometry.fairing.hvid import is_closed
 from .hvid_properties import HvidProperties, draw_jobcard
 from .import_airfoil import stored_airfoil
 from .nurbs_objects import curve_to_object, object_to_geometry, remove_object, stored_geometry
+from .scene_guard import check_output_file, unchanged_on_refusal
 
 #: Points farther than this fraction of the curve's size from its best-fit plane make
 #: the curve non-planar (float32 coordinates leave ~1e-7 of noise).
 PLANAR_TOL = 1e-5
+
+#: Fewest control points of a curve to smooth (the cubic through them needs 4).
+MIN_CURVE_POINTS = 4
 
 #: Samples per knot span used to read a non-polyline curve as airfoil data.
 AIRFOIL_SAMPLES_PER_SPAN = 2
@@ -83,6 +87,9 @@ def read_planar_curve(obj) -> tuple[BSplineCurve, np.ndarray, np.ndarray]:
     curve = curves[0]
     if not isinstance(curve, BSplineCurve):
         raise GeometryError(f"{obj.name}: expected a curve, got a surface")
+    if len(curve.control_points) < MIN_CURVE_POINTS:
+        raise GeometryError(f"{obj.name}: the curve has {len(curve.control_points)} points; smoothing needs at "
+                            f"least {MIN_CURVE_POINTS}")
     if curve.dim == 2:
         return curve, np.zeros(3), np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     P = curve.control_points[:, :3]
@@ -190,14 +197,19 @@ class BLADESMITH_OT_smooth_curve(HvidProperties, bpy.types.Operator):
         obj = context.active_object
         return obj is not None and obj.type == "CURVE"
 
+    @unchanged_on_refusal
     def execute(self, context):
         obj = context.active_object
         wm = context.window_manager
         wm.progress_begin(0, 100)
         try:
+            path = check_output_file(self.filepath) if self.filepath else ""
             result, origin, axes = self._smooth(obj, lambda done, total: wm.progress_update(int(90 * done / max(total, 1))))
-            if self.filepath:
-                write_points(bpy.path.abspath(self.filepath), result.points)
+            if path:
+                try:
+                    write_points(path, result.points)
+                except OSError as exc:
+                    raise DefinitionError(f"cannot write {path!r}: {exc.strerror or exc}", field="filepath") from None
             made = build_objects(obj, result, origin, axes, self.plot_height, self.comb_length, self.deviation_gain) if self.make_plots else None
             if made is None:
                 collection = obj.users_collection[0] if obj.users_collection else context.scene.collection

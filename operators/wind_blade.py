@@ -48,7 +48,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from ..geometry.errors import BladesmithError, DefinitionError
+from ..geometry.errors import BladesmithError, DefinitionError, GeometryError
 from ..geometry.mold import (
     BladeDefinition,
     BladeMolds,
@@ -68,6 +68,7 @@ from . import nurbs_objects
 from .progress import progress_callback
 from .nurbs_objects import remove_object, write_curve, write_surface
 from .values import typed
+from .scene_guard import unchanged_on_refusal
 
 #: Custom property naming a child's part (a key of BladeMolds.surfaces / parting_lines, or "single").
 PART_KEY = "bladesmith_mold_part"
@@ -445,6 +446,7 @@ class BLADESMITH_OT_add_wind_blade(bpy.types.Operator):
             return self.preset
         return self.preset_choice
 
+    @unchanged_on_refusal
     def execute(self, context):
         wm = context.window_manager
         wm.progress_begin(0, 100)
@@ -453,7 +455,10 @@ class BLADESMITH_OT_add_wind_blade(bpy.types.Operator):
             tolerance = typed(self.tolerance)  # the float32 property as typed
             check_fit_settings(self.control_points, tolerance)
             defn = _override(load_definition(self.definition, self._preset_name()), self.control_points, tolerance)
-            molds = compute_molds(defn, fairness=self.fairness, progress=progress_callback(wm))
+            try:
+                molds = compute_molds(defn, fairness=self.fairness, progress=progress_callback(wm))
+            except GeometryError as exc:  # the station and cause are in the message; name the file
+                raise DefinitionError(str(exc), path=defn.path or None) from None
             root = create_wind_blade(context, molds, self.mold_halves, time.perf_counter() - start)
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))

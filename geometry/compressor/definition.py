@@ -46,16 +46,21 @@ Format (lengths in metres, angles in degrees; see README "Impeller definition"):
     hub_factor = 1.0               # new hub = shroud + f (hub - shroud): < 1 a hub cut
 
 See :class:`StandardisationDefinition` for why the factors have a table of their own.
+
+Keys are checked against ``TOP_KEYS``, ``CHANNEL_KEYS``, ``BLADE_KEYS``, ``SPLITTER_KEYS``
+and ``STANDARDISATION_KEYS`` (the one place to add a key); an unknown key is refused with
+the nearest valid name. Counts and sizes are bounded by the ``MAX_*`` constants below
+(README "Limits of definitions"), named in the refusal.
 """
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..errors import DefinitionError, GeometryError
+from ..validation import MAX_LENGTH, MIN_LENGTH, check_count, check_keys, number, number_list, read_toml, string, table
 from .blade import (DEFAULT_TOLERANCE, MAX_BETA_DEG, PATCH_SPACINGS, WALL_TOLERANCE, BladeSurfaces, WallBlade,
                     WallCamber, build_blade, outer_diameter)
 from .channel import MeridionalChannel, WallSkeleton, channel_from_skeleton
@@ -64,33 +69,54 @@ from .uses import CutError, scaled_channel
 
 WALLS = ("hub", "shroud")
 
+#: The keys of each table (the one place to add a key).
+TOP_KEYS = ("name", "channel", "blade", "splitter", "standardisation")
+CHANNEL_KEYS = ("degrees", "hub_z", "hub_r", "hub_angle", "hub_fractions", "shroud_z", "shroud_r", "shroud_angle",
+                "shroud_fractions")
+BLADE_KEYS = ("count", "leading_edge_hub", "leading_edge_shroud", "trailing_edge_hub", "trailing_edge_shroud",
+              "beta_hub", "beta_shroud", "thickness_hub", "thickness_shroud", "patches", "lean_hub", "lean_shroud",
+              "elements", "leading_edge_ratio", "trailing_edge_ratio", "tolerance", "patch_spacing")
+SPLITTER_KEYS = ("leading_edge_hub", "leading_edge_shroud", "thickness_hub", "thickness_shroud", "pitch_fraction",
+                 "patches", "leading_edge_ratio")
 
-def _floats(data: dict, key: str, section: str, path, length: int | None = None) -> tuple:
+# Upper bounds (README "Limits of definitions"); each is named in its refusal.
+#: Blades Z (main blades; splitters double the count): real impellers have 7-30.
+MAX_BLADES = 64
+#: Patches of the meridional channel (Casey's skeleton has 3-6).
+MAX_CHANNEL_PATCHES = 20
+#: Cubic-linear patches per blade surface (Casey uses 4-8; the adaptive count that holds
+#: the wall and camber tolerances reaches 65-74 on the shipped presets).
+MAX_BLADE_PATCHES = 200
+#: Bernstein coefficients of β(m̄) and δ(m̄) per wall (degree + 1; Casey uses 3-6).
+MAX_COEFFICIENTS = 30
+#: |wall angle| and |lean| (degrees).
+MAX_ANGLE_DEG = 180.0
+#: The fractions placing P_1 and P_3 of a bend lie in [MIN_FRACTION, 1 - MIN_FRACTION]:
+#: nearer the ends, a leg of the bend's polygon degenerates (a zero end tangent).
+MIN_FRACTION = 0.05
+#: Rounded-edge ellipse semi-axes ratio.
+MAX_EDGE_RATIO = 20.0
+
+
+def _floats(data: dict, key: str, section: str, path, length: int | None = None, *, maximum: int = MAX_COEFFICIENTS,
+            bound_name: str = "MAX_COEFFICIENTS", lo=-MAX_LENGTH, hi=MAX_LENGTH) -> tuple:
     name = f"{section}.{key}"
     if key not in data:
         raise DefinitionError("missing", path=path, field=name)
     value = data[key]
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise DefinitionError(f"expected numbers, got {value!r}", path=path, field=name) from None
-    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
-        raise DefinitionError(f"expected a list of finite numbers, got {value!r}", path=path, field=name)
-    if length is not None and arr.size != length:
-        raise DefinitionError(f"expected {length} values, got {arr.size}", path=path, field=name)
-    return tuple(float(x) for x in arr)
+    out = number_list(value, path, name, maximum=maximum, bound_name=bound_name, lo=lo, hi=hi)
+    if length is not None and len(out) != length:
+        raise DefinitionError(f"expected {length} values, got {len(out)}", path=path, field=name)
+    return out
 
 
-def _number(data: dict, key: str, section: str, path, default=None) -> float:
+def _number(data: dict, key: str, section: str, path, default=None, lo=None, hi=None) -> float:
     name = f"{section}.{key}"
     if key not in data:
         if default is None:
             raise DefinitionError("missing", path=path, field=name)
         return float(default)
-    v = data[key]
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise DefinitionError(f"expected a number, got {v!r}", path=path, field=name)
-    return float(v)
+    return number(data[key], path, name, lo=lo, hi=hi)
 
 
 @dataclass(frozen=True)
@@ -107,34 +133,57 @@ class ChannelDefinition:
 
     @classmethod
     def from_dict(cls, data: dict, path=None) -> "ChannelDefinition":
+        check_keys(table(data, path, "channel"), CHANNEL_KEYS, path, "channel")
         if "degrees" not in data:
             raise DefinitionError("missing", path=path, field="channel.degrees")
-        degrees = tuple(int(d) for d in data["degrees"])
+        raw_degrees = data["degrees"]
+        if not isinstance(raw_degrees, list) or not raw_degrees:
+            raise DefinitionError(f"expected a list of patch degrees (1 or 4), got {raw_degrees!r}", path=path,
+                                  field="channel.degrees")
+        check_count(len(raw_degrees), MAX_CHANNEL_PATCHES, "MAX_CHANNEL_PATCHES", path, "channel.degrees", "patches")
+        degrees = []
+        for j, d in enumerate(raw_degrees):
+            d = number(d, path, "channel.degrees", integer=True, entry=f"patch {j}: ")
+            if d not in (1, 4):
+                raise DefinitionError(f"patch {j}: degree must be 1 (straight) or 4 (bend), got {d}", path=path,
+                                      field="channel.degrees")
+            degrees.append(d)
+        degrees = tuple(degrees)
         n = len(degrees)
         values = {"degrees": degrees}
         for w in WALLS:
-            values[f"{w}_z"] = _floats(data, f"{w}_z", "channel", path, n + 1)
-            values[f"{w}_r"] = _floats(data, f"{w}_r", "channel", path, n + 1)
+            values[f"{w}_z"] = _floats(data, f"{w}_z", "channel", path, n + 1, maximum=MAX_CHANNEL_PATCHES + 1,
+                                       bound_name="MAX_CHANNEL_PATCHES + 1")
+            values[f"{w}_r"] = _floats(data, f"{w}_r", "channel", path, n + 1, maximum=MAX_CHANNEL_PATCHES + 1,
+                                       bound_name="MAX_CHANNEL_PATCHES + 1", lo=0.0)
             raw = data.get(f"{w}_angle", ["auto"] * (n + 1))
-            if len(raw) != n + 1:
-                raise DefinitionError(f"expected {n + 1} values", path=path, field=f"channel.{w}_angle")
+            if not isinstance(raw, list) or len(raw) != n + 1:
+                raise DefinitionError(f"expected a list of {n + 1} angles or \"auto\", got {raw!r}", path=path,
+                                      field=f"channel.{w}_angle")
             angles = []
-            for a in raw:
+            for i, a in enumerate(raw):
                 if a == "auto":
                     angles.append(math.nan)
                 elif isinstance(a, (int, float)) and not isinstance(a, bool):
-                    angles.append(float(a))
+                    angles.append(number(a, path, f"channel.{w}_angle", lo=-MAX_ANGLE_DEG, hi=MAX_ANGLE_DEG,
+                                         entry=f"corner {i}: "))
                 else:
-                    raise DefinitionError(f"expected a number or \"auto\", got {a!r}", path=path, field=f"channel.{w}_angle")
+                    raise DefinitionError(f"corner {i}: expected a number or \"auto\", got {a!r}", path=path,
+                                          field=f"channel.{w}_angle")
             values[f"{w}_angle"] = tuple(angles)
             fr = data.get(f"{w}_fractions", [[0.5, 0.5]] * n)
-            try:
-                fr = np.asarray(fr, dtype=float)
-            except (TypeError, ValueError):
-                raise DefinitionError("expected pairs of numbers", path=path, field=f"channel.{w}_fractions") from None
+            if not isinstance(fr, list) or len(fr) != n or not all(isinstance(q, list) and len(q) == 2 for q in fr):
+                raise DefinitionError(f"expected {n} pairs [fa, fb], got {fr!r}", path=path,
+                                      field=f"channel.{w}_fractions")
+            fr = np.array([[number(v, path, f"channel.{w}_fractions", lo=MIN_FRACTION, hi=1.0 - MIN_FRACTION,
+                                   entry=f"pair {j}: ") for v in q] for j, q in enumerate(fr)], dtype=float).reshape(n, 2)
             if fr.shape != (n, 2):
                 raise DefinitionError(f"expected {n} pairs, got shape {fr.shape}", path=path, field=f"channel.{w}_fractions")
             values[f"{w}_fractions"] = tuple(map(tuple, fr.tolist()))
+        size = max(np.ptp(values[f"{w}_{c}"] + values[f"{v}_{c}"]) for w in WALLS for v in WALLS for c in "zr")
+        if size < MIN_LENGTH:
+            raise DefinitionError(f"the channel spans {size!r} m, less than MIN_LENGTH = {MIN_LENGTH:g} m (the "
+                                  "float32 display would lose it)", path=path, field="channel.hub_z")
         return cls(**values)
 
     def to_dict(self) -> dict:
@@ -191,12 +240,15 @@ class BladeDefinition:
     @classmethod
     def from_dict(cls, data: dict, path=None) -> "BladeDefinition":
         s = "blade"
+        check_keys(table(data, path, "blade"), BLADE_KEYS, path, "blade")
         count = data.get("count")
         if isinstance(count, bool) or not isinstance(count, int) or count < 1:
             raise DefinitionError(f"expected a positive integer, got {count!r}", path=path, field="blade.count")
+        check_count(count, MAX_BLADES, "MAX_BLADES", path, "blade.count", "blades")
         patches = data.get("patches", 6)
         if isinstance(patches, bool) or not isinstance(patches, int) or patches < 1:
             raise DefinitionError(f"expected a positive integer, got {patches!r}", path=path, field="blade.patches")
+        check_count(patches, MAX_BLADE_PATCHES, "MAX_BLADE_PATCHES", path, "blade.patches", "patches")
         choices = {}
         for key, allowed in BLADE_CHOICES.items():
             choices[key] = data.get(key, allowed[0])
@@ -207,8 +259,14 @@ class BladeDefinition:
         if values["tolerance"] < 0.0:
             raise DefinitionError(f"expected a number >= 0, got {values['tolerance']!r}", path=path, field="blade.tolerance")
         for w in WALLS:
-            values[f"beta_{w}"] = _floats(data, f"beta_{w}", s, path)
-            values[f"thickness_{w}"] = _floats(data, f"thickness_{w}", s, path)
+            values[f"lean_{w}"] = _number(data, f"lean_{w}", s, path, 0.0, -MAX_ANGLE_DEG, MAX_ANGLE_DEG)
+            values[f"beta_{w}"] = _floats(data, f"beta_{w}", s, path, lo=-MAX_BETA_DEG, hi=MAX_BETA_DEG)
+            if len(values[f"beta_{w}"]) < 2:
+                raise DefinitionError("expected at least 2 coefficients (the leading- and trailing-edge angles)",
+                                      path=path, field=f"blade.beta_{w}")
+            values[f"thickness_{w}"] = _floats(data, f"thickness_{w}", s, path, lo=0.0)
+        for key in ("leading_edge_ratio", "trailing_edge_ratio"):
+            values[key] = _number(data, key, s, path, BLADE_SCALARS[key], 0.0, MAX_EDGE_RATIO)
         return cls(count=count, patches=patches, **choices, **values)
 
     def to_dict(self) -> dict:
@@ -231,17 +289,19 @@ class SplitterDefinition:
     @classmethod
     def from_dict(cls, data: dict, path=None) -> "SplitterDefinition":
         s = "splitter"
+        check_keys(table(data, path, "splitter"), SPLITTER_KEYS, path, "splitter")
         patches = data.get("patches", 4)
         if isinstance(patches, bool) or not isinstance(patches, int) or patches < 1:
             raise DefinitionError(f"expected a positive integer, got {patches!r}", path=path, field="splitter.patches")
+        check_count(patches, MAX_BLADE_PATCHES, "MAX_BLADE_PATCHES", path, "splitter.patches", "patches")
         return cls(
             leading_edge_hub=_number(data, "leading_edge_hub", s, path),
             leading_edge_shroud=_number(data, "leading_edge_shroud", s, path),
-            thickness_hub=_floats(data, "thickness_hub", s, path),
-            thickness_shroud=_floats(data, "thickness_shroud", s, path),
-            pitch_fraction=_number(data, "pitch_fraction", s, path, 0.5),
+            thickness_hub=_floats(data, "thickness_hub", s, path, lo=0.0),
+            thickness_shroud=_floats(data, "thickness_shroud", s, path, lo=0.0),
+            pitch_fraction=_number(data, "pitch_fraction", s, path, 0.5, 0.0, 1.0),
             patches=patches,
-            leading_edge_ratio=_number(data, "leading_edge_ratio", s, path, 3.0),
+            leading_edge_ratio=_number(data, "leading_edge_ratio", s, path, 3.0, 0.0, MAX_EDGE_RATIO),
         )
 
     def to_dict(self) -> dict:
@@ -353,6 +413,8 @@ class ImpellerDefinition:
     @classmethod
     def from_dict(cls, data: dict, path=None) -> "ImpellerDefinition":
         path = None if path is None else str(path)
+        table(data, path, "definition")
+        check_keys(data, TOP_KEYS, path)
         if not isinstance(data.get("channel"), dict):
             raise DefinitionError("missing [channel] table", path=path, field="channel")
         if not isinstance(data.get("blade"), dict):
@@ -364,7 +426,7 @@ class ImpellerDefinition:
             if standardisation.is_identity:
                 standardisation = None
         return cls(
-            name=str(data.get("name", "Impeller")),
+            name=string(data.get("name", "Impeller"), path, "name"),
             channel=ChannelDefinition.from_dict(data["channel"], path),
             blade=BladeDefinition.from_dict(data["blade"], path),
             splitter=None if splitter is None else SplitterDefinition.from_dict(splitter, path),
@@ -374,14 +436,7 @@ class ImpellerDefinition:
 
     @classmethod
     def from_toml(cls, path) -> "ImpellerDefinition":
-        try:
-            with open(path, "rb") as fh:
-                data = tomllib.load(fh)
-        except OSError as exc:
-            raise DefinitionError(f"cannot read: {exc.strerror}", path=str(path)) from None
-        except tomllib.TOMLDecodeError as exc:
-            raise DefinitionError(f"not valid TOML: {exc}", path=str(path)) from None
-        return cls.from_dict(data, path)
+        return cls.from_dict(read_toml(path), path)
 
     def to_dict(self) -> dict:
         out = {"name": self.name, "channel": self.channel.to_dict(), "blade": self.blade.to_dict()}
@@ -429,7 +484,16 @@ class ImpellerDefinition:
                     raise DefinitionError(f"thickness must be >= 0, got {th.min()}", path=p, field=f"splitter.thickness_{w}")
 
     def build(self) -> ImpellerModel:
-        """Validate and build the float64 model (channel, blade, splitter)."""
+        """Validate and build the float64 model (channel, blade, splitter); a refusal names
+        the definition's file."""
+        try:
+            return self._build()
+        except DefinitionError as exc:
+            if exc.path or not self.path:
+                raise
+            raise exc.with_path(self.path) from None
+
+    def _build(self) -> ImpellerModel:
         channel = self.channel.build(self.path)
         self._check_blade(channel.count)
         b = self.blade

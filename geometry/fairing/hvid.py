@@ -168,6 +168,14 @@ class SmoothingNotConverged(GeometryError):
         super().__init__("\n".join(lines))
 
 
+# Upper bounds of the jobcard's counts (README "Limits of definitions"): the work of one
+# smoothing grows with them; each is named in its refusal.
+MAX_SMOOTHING_POINTS = 5000
+MAX_OUTPUT_POINTS = 10000
+MAX_ITERATIONS = 200
+MAX_PASSES = 10000
+
+
 @dataclass(frozen=True)
 class SmoothingSettings:
     """Parameters of the smoother, named after Hvid's jobcard (1993, Appendix and §3.4).
@@ -201,9 +209,17 @@ class SmoothingSettings:
             if not ok:
                 raise DefinitionError(f"{what}, got {getattr(self, name)!r}", field=name)
 
-        need(int(self.smoothing_points) >= 8, "smoothing_points", "nsmooth must be >= 8")
-        need(int(self.output_points) >= 4, "output_points", "np must be >= 4")
-        need(int(self.max_iterations) >= 1, "max_iterations", "ntrial must be >= 1")
+        for name in ("smoothing_points", "output_points", "max_iterations", "passes", "smoothing_type",
+                     "end_derivative_order"):
+            value = getattr(self, name)
+            need(not isinstance(value, bool) and isinstance(value, (int, np.integer)), name, "expected an integer")
+        need(8 <= self.smoothing_points <= MAX_SMOOTHING_POINTS, "smoothing_points",
+             f"nsmooth must lie in [8, MAX_SMOOTHING_POINTS = {MAX_SMOOTHING_POINTS}]")
+        need(4 <= self.output_points <= MAX_OUTPUT_POINTS, "output_points",
+             f"np must lie in [4, MAX_OUTPUT_POINTS = {MAX_OUTPUT_POINTS}]")
+        need(1 <= self.max_iterations <= MAX_ITERATIONS, "max_iterations",
+             f"ntrial must lie in [1, MAX_ITERATIONS = {MAX_ITERATIONS}]")
+        need(int(self.passes) <= MAX_PASSES, "passes", f"passes must be <= MAX_PASSES = {MAX_PASSES}")
         need(np.isfinite(self.tolx) and self.tolx >= 0, "tolx", "tolx must be >= 0")
         need(np.isfinite(self.tolf) and self.tolf >= 0, "tolf", "tolf must be >= 0")
         need(self.smoothing_type in SMOOTHING_TYPES, "smoothing_type", f"smoothing type must be one of {SMOOTHING_TYPES}")

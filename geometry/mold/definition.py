@@ -22,7 +22,10 @@ Format (every array of ``[stations]`` has one value per station, root to tip)::
     sweep = [...]       # optional, m (edgewise offset)
     airfoil = [...]     # a .dat path (relative to the TOML file) or a shipped name, or "circle"
 
-Errors are :class:`DefinitionError` naming the file, the field and the station.
+Errors are :class:`DefinitionError` naming the file, the field and the station. Keys are
+checked against ``TOP_KEYS`` and ``REQUIRED`` + ``OPTIONAL`` (the one place to add a key);
+an unknown key is refused with the nearest valid name. Counts and sizes are bounded by the
+``MAX_*`` constants below (README "Limits of definitions"), named in the refusal.
 
 ``smooth_airfoils``: every airfoil of an aerodynamic station (from
 ``first_aerodynamic_station`` on; "circle" excepted) is replaced by its outline smoothed
@@ -34,12 +37,12 @@ from __future__ import annotations
 
 import math
 import pathlib
-import tomllib
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..errors import BladesmithError, DefinitionError
+from ..validation import MAX_LENGTH, MIN_LENGTH, check_count, check_keys, read_toml, string
 from ..sections.airfoil_file import Airfoil, read_airfoil, smoothed_airfoil
 from ..sections.shape import DEFAULT_SMOOTH_PASSES, check_smooth_passes
 
@@ -83,6 +86,23 @@ TOP_LEVEL_KEYS = (
     "span_degree",        # q across the sections (Eq. 4), 1..5, default 3
     "tangent_magnitude",  # "sqp" (default: optimised, §4 Fig. 7b) or [upper, lower] by hand (Fig. 7a)
 )
+#: The keys of the top level ([stations] takes REQUIRED + OPTIONAL).
+TOP_KEYS = TOP_LEVEL_KEYS
+
+# Upper bounds (README "Limits of definitions"); each is named in its refusal.
+#: Stations: real blades have 10-60 (windIO grids about 50).
+MAX_STATIONS = 300
+#: Control points per half and section (the fit raises the count up to
+#: mold.blade.MAX_CONTROL_POINTS; a start above it is refused here).
+MAX_START_CONTROL_POINTS = 60
+#: Fewest stations from first_aerodynamic_station on (the skinning is cubic across the span).
+MIN_AERODYNAMIC_STATIONS = 4
+#: |twist| (degrees).
+MAX_TWIST_DEG = 180.0
+#: The smallest fitting tolerance (fraction of the chord): below, float64 rounding of the
+#: fit is as large as the tolerance.
+MIN_TOLERANCE = 1e-9
+MAX_TOLERANCE = 0.1
 
 
 def circle_airfoil() -> Airfoil:
@@ -190,15 +210,18 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
     """Validate a parsed definition. Bad stations are refused with the station named."""
     if not isinstance(data, dict):
         raise DefinitionError("expected a table", path=path)
-    name = str(data.get("name", pathlib.Path(path).stem if path else "blade"))
+    check_keys(data, TOP_KEYS, path)
+    name = string(data.get("name", pathlib.Path(path).stem if path else "blade"), path, "name")
     hub = _number(data.get("hub_radius", 0.0), path, "hub_radius")
     st = data.get("stations")
     if not isinstance(st, dict):
         raise DefinitionError("missing [stations] table", path=path, field="stations")
+    check_keys(st, REQUIRED + OPTIONAL, path, "stations")
     for key in REQUIRED:
         if key not in st:
             raise DefinitionError("missing array", path=path, field=f"stations.{key}")
     count = len(st["r"]) if isinstance(st["r"], list) else -1
+    check_count(count, MAX_STATIONS, "MAX_STATIONS", path, "stations.r", "stations")
     if count < 2:
         raise DefinitionError(f"expected an array of at least 2 stations, got {st['r']!r}", path=path, field="stations.r")
     for key in REQUIRED + OPTIONAL:
@@ -212,13 +235,27 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
             raise DefinitionError(
                 f"station {k}: r = {vals['r']!r} m does not increase (station {k - 1} has r = {stations[-1].r!r} m)",
                 path=path, field=f"stations.r[{k}]")
-        if vals["r"] <= 0:
-            raise DefinitionError(f"station {k}: r must be > 0, got {vals['r']!r}", path=path, field=f"stations.r[{k}]")
+        if not 0 < vals["r"] <= MAX_LENGTH:
+            raise DefinitionError(f"station {k}: r must lie in (0, MAX_LENGTH = {MAX_LENGTH:g}] m, got {vals['r']!r}",
+                                  path=path, field=f"stations.r[{k}]")
         if vals["chord"] <= 0:
             raise DefinitionError(f"station {k}: chord must be > 0, got {vals['chord']!r}", path=path,
                                   field=f"stations.chord[{k}]")
+        if not MIN_LENGTH <= vals["chord"] <= MAX_LENGTH:
+            raise DefinitionError(f"station {k}: chord must lie in [MIN_LENGTH = {MIN_LENGTH:g}, MAX_LENGTH = "
+                                  f"{MAX_LENGTH:g}] m, got {vals['chord']!r}", path=path, field=f"stations.chord[{k}]")
+        if abs(vals["twist_deg"]) > MAX_TWIST_DEG:
+            raise DefinitionError(f"station {k}: |twist| is limited to MAX_TWIST_DEG = {MAX_TWIST_DEG:g} deg, got "
+                                  f"{vals['twist_deg']!r}", path=path, field=f"stations.twist_deg[{k}]")
+        if not 0.0 <= vals["pitch_axis"] <= 1.0:
+            raise DefinitionError(f"station {k}: the pitch axis is a chord fraction from the leading edge in [0, 1], "
+                                  f"got {vals['pitch_axis']!r}", path=path, field=f"stations.pitch_axis[{k}]")
+        for key, value in extra.items():
+            if abs(value) > MAX_LENGTH:
+                raise DefinitionError(f"station {k}: |{key}| must not exceed MAX_LENGTH = {MAX_LENGTH:g} m, got "
+                                      f"{value!r}", path=path, field=f"stations.{key}[{k}]")
         spec = st["airfoil"][k]
-        if not isinstance(spec, str) or not spec:
+        if not isinstance(spec, str) or not spec or len(spec) > 4096:
             raise DefinitionError(f"station {k}: expected an airfoil name or path, got {spec!r}", path=path,
                                   field=f"stations.airfoil[{k}]")
         try:
@@ -228,6 +265,17 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
                                   field=f"stations.airfoil[{k}]") from None
         stations.append(Station(vals["r"], vals["chord"], vals["twist_deg"], vals["pitch_axis"], foil,
                                 extra.get("prebend", 0.0), extra.get("sweep", 0.0), spec))
+    if not 0.0 <= hub <= stations[0].r:
+        raise DefinitionError(f"must lie in [0, r of station 0 = {stations[0].r!r}] m, got {hub!r}", path=path,
+                              field="hub_radius")
+    for key in ("prebend", "sweep"):
+        if key in st:
+            span = stations[-1].r
+            worst = max(abs(getattr(s, key)) for s in stations)
+            if worst > span:
+                k = max(range(count), key=lambda i: abs(getattr(stations[i], key)))
+                raise DefinitionError(f"station {k}: |{key}| = {worst!r} m is more than the tip radius {span!r} m",
+                                      path=path, field=f"stations.{key}[{k}]")
     direction = data.get("mold_direction", [0.0, 1.0, 0.0])
     if not isinstance(direction, list) or len(direction) != 3:
         raise DefinitionError(f"expected [x, y, z], got {direction!r}", path=path, field="mold_direction")
@@ -238,12 +286,20 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
     if isinstance(first, bool) or not isinstance(first, int) or not 0 <= first <= count - 2:
         raise DefinitionError(f"expected an integer in [0, {count - 2}], got {first!r}", path=path,
                               field="first_aerodynamic_station")
+    if count - first < MIN_AERODYNAMIC_STATIONS:
+        raise DefinitionError(
+            f"the aerodynamic zone (stations {first} to {count - 1}) has {count - first} stations; skinning them "
+            f"(degree 3 across the span) needs at least {MIN_AERODYNAMIC_STATIONS}", path=path,
+            field="first_aerodynamic_station" if first else "stations.r")
     n = data.get("control_points", DEFAULT_CONTROL_POINTS)
     if isinstance(n, bool) or not isinstance(n, int) or n < 5:
         raise DefinitionError(f"expected an integer >= 5, got {n!r}", path=path, field="control_points")
+    check_count(n, MAX_START_CONTROL_POINTS, "MAX_START_CONTROL_POINTS", path, "control_points",
+                "control points per half")
     tol = _number(data.get("tolerance", DEFAULT_TOLERANCE), path, "tolerance")
-    if tol <= 0:
-        raise DefinitionError(f"expected a positive chord fraction, got {tol!r}", path=path, field="tolerance")
+    if not MIN_TOLERANCE <= tol <= MAX_TOLERANCE:
+        raise DefinitionError(f"expected a chord fraction in [MIN_TOLERANCE = {MIN_TOLERANCE:g}, "
+                              f"MAX_TOLERANCE = {MAX_TOLERANCE:g}], got {tol!r}", path=path, field="tolerance")
     wrap = data.get("wrap", True)
     if not isinstance(wrap, bool):
         raise DefinitionError(f"expected true or false, got {wrap!r}", path=path, field="wrap")
@@ -337,13 +393,7 @@ def load_blade(path) -> BladeDefinition:
         from .windio import load_windio_blade
 
         return load_windio_blade(path)
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except FileNotFoundError:
-        raise DefinitionError("definition file not found", path=str(path)) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise DefinitionError(f"not valid TOML ({exc})", path=str(path)) from None
+    data = read_toml(path)
     return blade_from_dict(data, str(path), path.parent)
 
 

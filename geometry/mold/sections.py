@@ -111,7 +111,7 @@ def find_silhouette(curve: BSplineCurve, params, chordwise, direction, wrap: boo
     """
     d = np.asarray(direction, dtype=np.float64)
     if np.linalg.norm(np.cross(d, SPAN_AXIS)) < DIRECTION_TOL * np.linalg.norm(d):
-        raise GeometryError("the mold direction gives no silhouette point: it is (nearly) along the span axis")
+        raise GeometryError("the mold_direction gives no silhouette point: it is (nearly) along the span axis")
     f = silhouette_function(curve, params, d, wrap)
     x = np.asarray(chordwise)
     change = np.flatnonzero((np.sign(f[:-1]) != np.sign(f[1:])) & (np.minimum(x[:-1], x[1:]) < LE_REGION))
@@ -119,7 +119,7 @@ def find_silhouette(curve: BSplineCurve, params, chordwise, direction, wrap: boo
     if exact.size:
         return float(params[exact[np.argmin(x[exact])]])
     if not change.size:
-        raise GeometryError("the mold direction gives no silhouette point in the leading-edge region")
+        raise GeometryError("the mold_direction gives no silhouette point in the leading-edge region")
     k = change[np.argmin(np.minimum(x[change], x[change + 1]))]
     return float(brentq(lambda t: float(silhouette_function(curve, np.array([t]), d, wrap)[0]),
                         params[k], params[k + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))

@@ -40,6 +40,11 @@ Format (every field is checked; messages name the file, the field and the value)
 
 A CSV radial table has a header line with those column names ('#' lines are comments;
 ``t0_c`` and ``f0_c`` are accepted for ``t_c`` and ``f_c``).
+
+Every key is checked against the table's list of keys below (``_TOP_KEYS``,
+``_SECTION_KEYS``, ``_HUB_KEYS``, ``RADIAL_FIELDS``: the one place to add a key); an
+unknown key is refused with the nearest valid name. Counts and sizes are bounded by the
+``MAX_*`` constants below (README "Limits of definitions"), named in the refusal.
 """
 from __future__ import annotations
 
@@ -48,13 +53,14 @@ import io
 import math
 import os
 import pathlib
-import tomllib
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
 from ..files import atomic_write
 from ..errors import DefinitionError
+from ..validation import (MAX_LENGTH, MIN_LENGTH, check_count, check_keys, number, read_text, read_toml, string,
+                          table)
 from ..sections.shape import DEFAULT_SMOOTH_PASSES, check_smooth_passes
 
 RADIAL_FIELDS = ("r_R", "c_D", "P_D", "skew_deg", "rake_D", "t_c", "f_c")
@@ -75,6 +81,24 @@ _SECTION_KEYS = {"thickness", "meanline", "thickness_x_c", "thickness_t", "meanl
 #: Thickness names that are not airfoil files.
 _THICKNESS_FORMS = ("naca66mod", "naca4", "elliptic", "table")
 _HUB_KEYS = {"upstream_length", "downstream_length", "nose_shape", "nose_length", "tail_shape", "tail_length"}
+
+# Upper bounds (README "Limits of definitions"); each is named in its refusal.
+#: Blades Z: marine and air propellers and fans have 2-12.
+MAX_BLADES = 32
+#: Radial stations (rows of [radial] or of the CSV table): published tables have 10-30.
+MAX_RADIAL_STATIONS = 500
+#: Points of a section thickness or mean-line table.
+MAX_SECTION_TABLE_POINTS = 1000
+#: |skew angle| (degrees): a blade skewed further would wrap into its neighbours.
+MAX_SKEW_DEG = 180.0
+#: |rake| / D, pitch / D and chord / D.
+MAX_RAKE_D = 10.0
+MAX_PITCH_D = 100.0
+MAX_CHORD_D = 10.0
+#: |camber| / chord.
+MAX_CAMBER_C = 0.5
+#: Hub lengths as multiples of D.
+MAX_HUB_LENGTH_D = 10.0
 
 
 def _fmt(value) -> str:
@@ -191,13 +215,14 @@ class Propeller:
 
     def __post_init__(self):
         p = self.source
-        if not isinstance(self.name, str) or not self.name.strip():
-            raise DefinitionError(f"expected a non-empty string, got {_fmt(self.name)}", path=p, field="name")
-        object.__setattr__(self, "blades", _number(self.blades, "blades", p, minimum=1, integer=True))
-        object.__setattr__(self, "diameter", _number(self.diameter, "diameter", p, positive=True))
-        h = _number(self.hub_diameter_ratio, "hub_diameter_ratio", p, positive=True)
+        string(self.name, p, "name")
+        object.__setattr__(self, "blades", number(self.blades, p, "blades", lo=1, integer=True))
+        check_count(self.blades, MAX_BLADES, "MAX_BLADES", p, "blades", "blades")
+        # the float32 display keeps the geometry only between MIN_LENGTH and MAX_LENGTH
+        object.__setattr__(self, "diameter", number(self.diameter, p, "diameter", lo=MIN_LENGTH, hi=MAX_LENGTH))
+        h = number(self.hub_diameter_ratio, p, "hub_diameter_ratio", lo=0.0, hi=1.0, lo_open=True, hi_open=True)
         object.__setattr__(self, "hub_diameter_ratio", h)
-        if self.hand not in HANDS:
+        if not isinstance(self.hand, str) or self.hand not in HANDS:
             raise DefinitionError(f"expected 'right' or 'left', got {_fmt(self.hand)}", path=p, field="hand")
         self._validate_radial()
         tip = self.radial.r_R[-1]
@@ -216,7 +241,10 @@ class Propeller:
         p, rad = self.source, self.radial
         arrays = {}
         for name in RADIAL_FIELDS:
-            arrays[name] = _array(getattr(rad, name), f"radial.{name}", p)
+            value = getattr(rad, name)
+            if isinstance(value, (list, tuple, np.ndarray)):
+                check_count(len(value), MAX_RADIAL_STATIONS, "MAX_RADIAL_STATIONS", p, f"radial.{name}", "stations")
+            arrays[name] = _array(value, f"radial.{name}", p)
         n = len(arrays["r_R"])
         if n < 3:
             raise DefinitionError(f"need at least 3 stations, got {n}", path=p, field="radial.r_R")
@@ -256,6 +284,14 @@ class Propeller:
         if np.any(t >= 1.0):
             i = int(np.argmax(t >= 1.0))
             raise DefinitionError(f"entry {i} (r_R = {r[i]}) is {t[i]}; thickness must be below the chord", path=p, field="radial.t_c")
+        for name, bound, bound_name in (("c_D", MAX_CHORD_D, "MAX_CHORD_D"), ("P_D", MAX_PITCH_D, "MAX_PITCH_D"),
+                                        ("skew_deg", MAX_SKEW_DEG, "MAX_SKEW_DEG"), ("rake_D", MAX_RAKE_D, "MAX_RAKE_D"),
+                                        ("f_c", MAX_CAMBER_C, "MAX_CAMBER_C")):
+            a = np.abs(np.asarray(arrays[name]))
+            if np.any(a > bound):
+                i = int(np.argmax(a > bound))
+                raise DefinitionError(f"entry {i} (r_R = {r[i]}) is {arrays[name][i]!r}; |{name}| is limited to "
+                                      f"{bound_name} = {bound:g}", path=p, field=f"radial.{name}")
 
     def _validate_section(self):
         p, s = self.source, self.section
@@ -265,6 +301,9 @@ class Propeller:
         for name in ("thickness_x_c", "thickness_t", "meanline_x_c", "meanline_f"):
             v = getattr(s, name)
             if v is not None:
+                if isinstance(v, (list, tuple, np.ndarray)):
+                    check_count(len(v), MAX_SECTION_TABLE_POINTS, "MAX_SECTION_TABLE_POINTS", p, f"section.{name}",
+                                "points")
                 object.__setattr__(s, name, _array(v, f"section.{name}", p))
         if not isinstance(s.smooth_airfoil, bool):
             raise DefinitionError(f"expected true or false, got {_fmt(s.smooth_airfoil)}", path=p,
@@ -304,11 +343,15 @@ class Propeller:
 
     def _validate_hub(self):
         p, hub = self.source, self.hub
+        longest = MAX_HUB_LENGTH_D * self.diameter
         for name in ("upstream_length", "downstream_length"):
             object.__setattr__(hub, name, _number(getattr(hub, name), f"hub.{name}", p, positive=True))
+            if getattr(hub, name) > longest:
+                raise DefinitionError(f"{getattr(hub, name)!r} m is more than MAX_HUB_LENGTH_D = {MAX_HUB_LENGTH_D:g} "
+                                      f"diameters ({longest:g} m)", path=p, field=f"hub.{name}")
         for end in ("nose", "tail"):
             shape = getattr(hub, f"{end}_shape")
-            if shape not in HUB_SHAPES:
+            if not isinstance(shape, str) or shape not in HUB_SHAPES:
                 raise DefinitionError(f"expected one of {', '.join(HUB_SHAPES)}, got {_fmt(shape)}", path=p, field=f"hub.{end}_shape")
             length = _number(getattr(hub, f"{end}_length"), f"hub.{end}_length", p, minimum=0.0)
             object.__setattr__(hub, f"{end}_length", length)
@@ -361,22 +404,19 @@ class Propeller:
     @classmethod
     def from_dict(cls, data: dict, source=None) -> "Propeller":
         p = str(source) if source is not None else None
-        unknown = set(data) - _TOP_KEYS
-        if unknown:
-            raise DefinitionError(f"unknown field(s) {sorted(unknown)}", path=p, field=sorted(unknown)[0])
+        table(data, p, "definition")
+        check_keys(data, _TOP_KEYS, p)
         for key in ("name", "blades", "diameter", "hub_diameter_ratio", "hand"):
             if key not in data:
                 raise DefinitionError("missing", path=p, field=key)
-        sec = data.get("section", {})
-        if not isinstance(sec, dict) or set(sec) - _SECTION_KEYS:
-            raise DefinitionError(f"unknown field(s) {sorted(set(sec) - _SECTION_KEYS)}", path=p, field="section")
+        sec = table(data.get("section", {}), p, "section")
+        check_keys(sec, _SECTION_KEYS, p, "section")
         hub = data.get("hub")
         if hub is None:
-            diameter = data["diameter"] if isinstance(data["diameter"], (int, float)) else 1.0
+            diameter = number(data["diameter"], p, "diameter", lo=MIN_LENGTH, hi=MAX_LENGTH)
             hub_def = HubDefinition.default_for(float(diameter))
         else:
-            if not isinstance(hub, dict) or set(hub) - _HUB_KEYS:
-                raise DefinitionError(f"unknown field(s) {sorted(set(hub) - _HUB_KEYS)}", path=p, field="hub")
+            check_keys(table(hub, p, "hub"), _HUB_KEYS, p, "hub")
             for key in ("upstream_length", "downstream_length"):
                 if key not in hub:
                     raise DefinitionError("missing", path=p, field=f"hub.{key}")
@@ -389,12 +429,10 @@ class Propeller:
             rad = data.get("radial")
             if not isinstance(rad, dict):
                 raise DefinitionError("missing [radial] table (or radial_table = \"file.csv\")", path=p, field="radial")
+            check_keys(rad, RADIAL_FIELDS, p, "radial")
             missing = [k for k in RADIAL_FIELDS if k not in rad]
             if missing:
                 raise DefinitionError("missing", path=p, field=f"radial.{missing[0]}")
-            extra = set(rad) - set(RADIAL_FIELDS)
-            if extra:
-                raise DefinitionError(f"unknown field(s) {sorted(extra)}", path=p, field=f"radial.{sorted(extra)[0]}")
             radial = RadialDistribution(**{k: rad[k] for k in RADIAL_FIELDS})
         return cls(
             name=data["name"],
@@ -412,13 +450,7 @@ class Propeller:
     def from_toml(cls, path) -> "Propeller":
         """Read and validate a definition file (tomllib)."""
         path = pathlib.Path(path)
-        try:
-            with open(path, "rb") as fh:
-                data = tomllib.load(fh)
-        except FileNotFoundError:
-            raise DefinitionError("definition file not found", path=str(path)) from None
-        except tomllib.TOMLDecodeError as exc:
-            raise DefinitionError(f"not valid TOML: {exc}", path=str(path)) from None
+        data = read_toml(path)
         return cls.from_dict(data, source=path.resolve())
 
     def to_dict(self, relative_to=None) -> dict:
@@ -461,13 +493,12 @@ def read_radial_csv(name, base_dir=None, source=None) -> RadialDistribution:
     path = pathlib.Path(name)
     if base_dir is not None and not path.is_absolute():
         path = pathlib.Path(base_dir) / path
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DefinitionError(f"radial table file {str(path)!r} not found", path=source, field="radial_table") from None
+    text = read_text(path, what="radial table file", source=str(path) if source is None else source,
+                     field="radial_table")
     lines = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1) if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise DefinitionError("empty radial table", path=str(path), field="radial_table")
+    check_count(len(lines) - 1, MAX_RADIAL_STATIONS, "MAX_RADIAL_STATIONS", str(path), "radial_table", "stations")
     reader = csv.reader(io.StringIO("\n".join(ln for _, ln in lines)))
     rows = list(reader)
     header = [CSV_ALIASES.get(h.strip(), h.strip()) for h in rows[0]]

@@ -237,7 +237,7 @@ def blade_display_surface(
             if len(U) - p - 1 > MAX_CONTROL_POINTS or len(V) - p - 1 > MAX_CONTROL_POINTS:
                 raise GeometryError(
                     f"the blade display surface needs more than {MAX_CONTROL_POINTS} control points per "
-                    f"direction for the tolerance {tol:.3g} m; use a larger display tolerance"
+                    f"direction for the tolerance {tol:.3g} m; use a larger display_tolerance"
                 )
             if progress is not None:
                 progress(min(0.9, 0.1 * rounds + 0.05 * (len(U) + len(V)) / MAX_CONTROL_POINTS))

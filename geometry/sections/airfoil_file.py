@@ -7,8 +7,14 @@
   surface from leading to trailing edge and the lower surface from leading to trailing edge.
 
 Lines starting with '#' are comments; non-numeric lines before the first coordinate (the
-name, a column header such as ``x_c y_c``) are skipped. A coordinate that is not a number,
-NaN or infinite, or a point repeating the previous one, is refused with the file and line.
+name, a column header such as ``x_c y_c``) are skipped. The name is the first of them that
+is not a column header, else the file name. A coordinate that is not a number, NaN or
+infinite, or a point repeating the previous one, is refused with the file and line; so are
+binary files, more than :data:`MAX_AIRFOIL_POINTS` points, fewer than 5, an outline that
+crosses itself (the two segments and their points named) and one of zero thickness.
+
+The trailing edge is sharp when its two ends are within :data:`SHARP_TE_TOL` chord of each
+other (re-panelled files leave ~1e-17 of rounding there), blunt otherwise.
 
 The result is normalised to unit chord: the leading edge (the point farthest from the
 trailing-edge midpoint) at the origin and the trailing-edge midpoint at (1, 0).
@@ -17,15 +23,31 @@ from __future__ import annotations
 
 import math
 import pathlib
+import re
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import DefinitionError
+from ..validation import read_bytes
 
 #: Two consecutive points closer than this (in the file's units, relative to the chord)
 #: are reported as duplicates.
 DUPLICATE_TOL = 1e-12
+#: Most coordinate lines read (README "Limits of definitions"); UIUC files have 30-400.
+MAX_AIRFOIL_POINTS = 5000
+#: A trailing edge thinner than this fraction of the chord is sharp.
+SHARP_TE_TOL = 1e-6
+#: An outline enclosing less than this area (in chord²) has zero thickness.
+MIN_AREA = 1e-6
+#: A non-numeric line made only of these words is a column header, not a name
+#: ("x y", "x_c y_c", "X/C Y/C", "x(c) y(c)").
+_HEADER_WORD = re.compile(r"^[(\[]?[xyz]([_/(]?c\)?)?[)\]]?[,;:]?$", re.IGNORECASE)
+
+
+def _is_header(line: str) -> bool:
+    words = line.replace(",", " ").split()
+    return bool(words) and all(_HEADER_WORD.match(w) for w in words)
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,15 +80,20 @@ class Airfoil:
     def trailing_edge_thickness(self) -> float:
         return float(np.linalg.norm(self.upper[-1] - self.lower[-1]))
 
+    @property
+    def sharp_trailing_edge(self) -> bool:
+        """The TE ends are within :data:`SHARP_TE_TOL` chord (the outline is at unit chord)."""
+        return self.trailing_edge_thickness <= SHARP_TE_TOL
+
 
 def _parse(path: pathlib.Path):
     """Numeric rows with their 1-based line numbers, and the name line."""
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except FileNotFoundError:
-        raise DefinitionError("airfoil file not found", path=str(path)) from None
-    except OSError as exc:
-        raise DefinitionError(f"cannot read airfoil file ({exc.strerror})", path=str(path)) from None
+    data = read_bytes(path, what="airfoil file")
+    nul = data.find(b"\0")
+    if nul >= 0:
+        raise DefinitionError(f"binary data (a NUL byte at offset {nul}), not an airfoil file", path=str(path))
+    # names in old files are often Latin-1: decode leniently, the numbers are ASCII
+    text = data.decode("utf-8", errors="replace")
     name = ""
     rows: list[tuple[int, list[float]]] = []
     blank_after: set[int] = set()  # indices of rows followed by a blank line (Lednicer)
@@ -89,7 +116,8 @@ def _parse(path: pathlib.Path):
         if values is None:
             if rows:
                 raise DefinitionError(f"line {lineno}: expected two numbers 'x y', got {line!r}", path=str(path))
-            name = name or line
+            if not name and not _is_header(line):
+                name = line
             continue
         if len(values) != 2:
             raise DefinitionError(f"line {lineno}: expected two numbers 'x y', got {line!r}", path=str(path))
@@ -97,6 +125,9 @@ def _parse(path: pathlib.Path):
             if not math.isfinite(v):
                 raise DefinitionError(f"line {lineno}: coordinate is {v} (NaN or infinite): {line!r}", path=str(path))
         rows.append((lineno, values))
+        if len(rows) > MAX_AIRFOIL_POINTS + 1:  # + 1: a Lednicer count line
+            raise DefinitionError(f"line {lineno}: more than MAX_AIRFOIL_POINTS = {MAX_AIRFOIL_POINTS} points",
+                                  path=str(path))
     if len(rows) < 5:
         raise DefinitionError(f"only {len(rows)} coordinate lines; an airfoil needs at least 5", path=str(path))
     return name or path.stem, rows
@@ -109,8 +140,8 @@ def _check_duplicates(points: np.ndarray, lines: np.ndarray, path: pathlib.Path)
     if bad.size:
         i = bad[0]
         raise DefinitionError(
-            f"line {lines[i + 1]}: point ({points[i + 1, 0]:g}, {points[i + 1, 1]:g}) duplicates the point "
-            f"on line {lines[i]}",
+            f"line {lines[i + 1]}: point {i + 1} ({points[i + 1, 0]:g}, {points[i + 1, 1]:g}) duplicates "
+            f"the point on line {lines[i]} (point {i})",
             path=str(path),
         )
 
@@ -165,7 +196,9 @@ def read_airfoil(path) -> Airfoil:
         te_mid = 0.5 * (pts[0] + pts[-1])
         outline = pts
         fmt = "selig"
+    _check_crossing(outline, None if is_lednicer else lines, path)
     first, second = _normalised_sides(outline, te_mid, path)
+    _check_thickness(np.concatenate([first[::-1], second[1:]]), path)
     if is_lednicer:
         upper, lower = first, second
     else:
@@ -177,6 +210,51 @@ def read_airfoil(path) -> Airfoil:
             upper, lower = second, first
             fmt = "reverse-selig"
     return Airfoil(name=name, upper=upper, lower=lower, format=fmt, path=str(path))
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+#: Segments compared at once by the crossing test (bounds its memory to ~100 MB).
+_CROSSING_BLOCK = 256
+
+
+def _check_crossing(outline: np.ndarray, lines, path) -> None:
+    """Refuse an outline (in file order) two of whose non-adjacent segments cross,
+    naming the points (0-based, in the order read) and, when known, their lines. Work is
+    O(n²) in blocks; n is bounded by :data:`MAX_AIRFOIL_POINTS`."""
+    a, b = outline[:-1], outline[1:]
+    d = b - a
+    m = len(a)
+    for start in range(0, m, _CROSSING_BLOCK):
+        i = np.arange(start, min(start + _CROSSING_BLOCK, m))[:, None]
+        j = np.arange(m)[None, :]
+        ai, di = a[i[:, 0]][:, None, :], d[i[:, 0]][:, None, :]
+        aj, dj = a[None, :, :], d[None, :, :]
+        d1 = _cross(dj, ai - aj)
+        d2 = _cross(dj, ai + di - aj)
+        d3 = _cross(di, aj - ai)
+        d4 = _cross(di, aj + dj - ai)
+        hit = (d1 * d2 < 0) & (d3 * d4 < 0) & (j > i + 1)
+        if hit.any():
+            p, q = np.argwhere(hit)[0]
+            p, q = int(i[p, 0]), int(q)
+            where = "" if lines is None else f" (lines {lines[p]}-{lines[p + 1]} and {lines[q]}-{lines[q + 1]})"
+            raise DefinitionError(
+                f"the outline crosses itself: the segment from point {p} to {p + 1} crosses the segment from "
+                f"point {q} to {q + 1}{where}", path=str(path))
+
+
+def _check_thickness(outline: np.ndarray, path) -> None:
+    """Refuse an outline (unit chord) enclosing (almost) no area: zero thickness."""
+    x, y = outline[:, 0], outline[:, 1]
+    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    if area < MIN_AREA:
+        k = int(np.argmax(np.abs(y)))
+        raise DefinitionError(
+            f"zero thickness: the outline encloses {area:.3g} chord², less than MIN_AREA = {MIN_AREA:g} "
+            f"(the point farthest from the chord line, point {k}, is {abs(y[k]):.3g} chord off it)", path=str(path))
 
 
 def airfoil_from_outline(outline, name: str, format: str = "selig", path: str = "") -> Airfoil:

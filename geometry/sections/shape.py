@@ -235,7 +235,11 @@ class SectionShape:
                     field="section.thickness",
                     path=source,
                 )
-            airfoil = read_airfoil(path)
+            try:
+                airfoil = read_airfoil(path)
+            except DefinitionError as exc:  # name the definition and its field, then the file's problem
+                raise DefinitionError(f"thickness = {thickness!r}: {exc}", field="section.thickness",
+                                      path=source) from None
             if smooth_airfoil:
                 airfoil = _smoothed(airfoil, source, smooth_passes)
             xs = _x_of_psi(np.linspace(0.0, np.pi, FORMULA_NODES + 1))

@@ -63,7 +63,7 @@ def test_smooth_tilted_poly_curve(scene):
     e1, e2 = np.array([1.0, 0, 0]), np.array([0, np.cos(0.6), np.sin(0.6)])
     pts = xy[:, :1] * e1 + xy[:, 1:] * e2
     _poly_object(pts)
-    assert bpy.ops.bladesmith.smooth_curve(kind="CURVE", alpha=100.0, smoothing_points=60, smoother="least_squares", smoothing_type="1") == {"FINISHED"}
+    assert bpy.ops.bladesmith.smooth_curve(kind="CURVE", alpha=100.0, smoothing_points=60, smoother="least_squares", smoothing_type=1) == {"FINISHED"}
     smoothed = bpy.data.objects["profile smoothed"]
     co = np.array([p.co[:3] for p in smoothed.data.splines[0].points])
     normal = np.cross(e1, e2)
@@ -77,7 +77,7 @@ def test_smooth_cyclic_poly_curve(scene):
     xy = np.stack([2 * np.cos(t), np.sin(t)], 1) + rng.uniform(-5e-4, 5e-4, (120, 2))
     _poly_object(np.column_stack([xy, np.zeros(120)]), "loop", cyclic=True)
     assert bpy.ops.bladesmith.smooth_curve(
-        kind="CURVE", alpha=100.0, smoothing_points=120, smoother="least_squares", smoothing_weight=1.0, smoothing_type="1"
+        kind="CURVE", alpha=100.0, smoothing_points=120, smoother="least_squares", smoothing_weight=1.0, smoothing_type=1
     ) == {"FINISHED"}
     smoothed = bpy.data.objects["loop smoothed"]
     assert smoothed["bladesmith_fairing"]["converged"]
@@ -93,7 +93,7 @@ def test_non_convergence_leaves_scene_unchanged(scene):
     before = {o.name for o in bpy.data.objects}
     curves_before = len(bpy.data.curves)
     with pytest.raises(RuntimeError, match="did not converge") as info:
-        bpy.ops.bladesmith.smooth_curve(kind="CURVE", alpha=1.0, smoothing_points=120, passes=20, smoothing_type="1")
+        bpy.ops.bladesmith.smooth_curve(kind="CURVE", alpha=1.0, smoothing_points=120, passes=20, smoothing_type=1)
     assert "residual" in str(info.value)
     assert {o.name for o in bpy.data.objects} == before
     assert len(bpy.data.curves) == curves_before and len(bpy.data.collections) == 0
