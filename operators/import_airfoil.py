@@ -82,9 +82,21 @@ class BLADESMITH_OT_import_airfoil(bpy.types.Operator, ImportHelper, HvidPropert
         default=False,
     )
 
-from .hvid_properties import JOBCARD, HvidProperties, draw_jobcard
-from .nurbs_objects import curve_to_object, remove_object
-from .scene_guard import unchanged_on_refusal
+    smooth: BoolProperty(
+        name="Smooth (Hvid)",
+        description="Smooth the imported airfoil with Hvid's smoothfoil (the settings below), as Smooth Curve (Hvid) does",
+        default=False,
+    )
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "chord")
+        layout.prop(self, "as_polyline")
+        layout.prop(self, "smooth")
+        if self.smooth:
+            draw_jobcard(layout.box(), self, "AIRFOIL", show_kind=False)
+
+    @unchanged_on_refusal
     def execute(self, context):
         try:
             airfoil = read_airfoil(self.filepath)
