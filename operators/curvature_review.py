@@ -602,7 +602,9 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
     shift = {"source": Vector((0.0, 0.0, 0.0)), "reference": Vector((-spacing, 0.0, 0.0))}
     result.settings["spacing"] = spacing
     # one colour scale for every deviation map, so they compare with each other
-    dlim = symmetric_limits(list(deviation.values()), 100.0) if deviation else None
+    # (a hub's deviation, like its curvature, does not set the blade's scale)
+    blade_dev = [d for (name, _), d in deviation.items() if not is_hub(bpy.data.objects.get(name))]
+    dlim = symmetric_limits(blade_dev or list(deviation.values()), 100.0) if deviation else None
     if dlim is not None:
         result.settings["deviation_limits"] = list(dlim)
     for role, owner, objs, entity, index, m in maps:
@@ -1082,7 +1084,8 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
     # and in the framed views they would only cover its root
     maps = [o for o in maps if _source_of(o) is None or int(_source_of(o).get("bladesmith_blade", 0)) == 0] or maps
     before = [o for o, r in roles if r[0] == "map" and r[1] == "reference"]
-    after_dev = [o for o, r in roles if r[0] == "deviation"]
+    after_dev = [o for o, r in roles if r[0] == "deviation"
+                 and not (hub_hidden and is_hub(bpy.data.objects.get(r[1]) if len(r) > 1 else None))]
     columns = [("", maps, 0.0)]
     if hub_hidden:
         before = [o for o in before if not is_hub(_source_of(o))]
@@ -1280,7 +1283,8 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
             layout["hub"] = {"rows": [top, top + hub_row.shape[0]], "limits": settings["hub_limits"],
                              "names": settings.get("hub", [])}
             blocks += [hub_row, strips[-1]]
-        layout["legends"] = [{"part": s.get("part", "blade" if hub_row is not None else ""),
+        layout["legends"] = [{"part": s.get("part", "blade" if hub_row is not None and s["quantity"] != "deviation"
+                                            else ""),
                               "quantity": s["quantity"], "limits": list(s["limits"])} for s in legends]
         image = np.concatenate(list(reversed(blocks)), axis=0)
         _write_png(image, filepath)

@@ -154,6 +154,10 @@ def test_hub_left_out_of_the_limits_and_sequential_map(scene):
     # included, the hub gets limits of its own; the blade keeps the blade's
     assert included["limits"] == pytest.approx(alone) and included["excluded_from_limits"] == []
     assert included["hub"] == ["Hub"] and included["hub_limits"][1] > 3 * alone[1]
+    # nor does the hub's deviation from a reference set the deviation scale
+    surface_to_object(bump_surface(0.052), "Before")
+    compared = cr.review_objects(scene, [blade, hub], comb_lines=0, reference="Before").settings
+    assert compared["deviation_max"] > 0.1 and compared["deviation_limits"][1] <= 0.002 + 1e-6
     energy = cr.review_objects(scene, [blade], quantity="strain_energy", comb_lines=0)
     lo, hi = energy.settings["limits"]
     assert lo == 0.0 and hi > 0.0
