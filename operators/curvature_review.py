@@ -77,6 +77,9 @@ ROLE_KEY = "bladesmith_review_role"
 NUMBERS_KEY = "bladesmith_review"
 #: Custom property on the collection (JSON): quantity, limits, units, clipped fraction.
 SETTINGS_KEY = "bladesmith_review_settings"
+#: Custom property on the collection (JSON) after the operator rendered an image: its path,
+#: views and legends' limits, and the pixel rows of an included hub's own panel.
+IMAGE_KEY = "bladesmith_review_image"
 VALUE_ATTRIBUTE = "bladesmith_value"
 COLOUR_ATTRIBUTE = "bladesmith_curvature"
 #: Maps are lifted along the normal by this fraction of the object's size (display only).
@@ -308,6 +311,11 @@ def _text_mesh(body: str, name: str, size: float, mesh=None):
     return new
 
 
+def hub_legend_settings(settings: dict) -> dict:
+    """The legend settings of an included hub (its own limits), from the review's."""
+    return dict(settings, limits=settings["hub_limits"], clipped=settings.get("hub_clipped", 0.0), part="hub")
+
+
 def _format(x: float) -> str:
     return f"{x:.3g}"
 
@@ -317,6 +325,8 @@ def legend_lines(settings: dict) -> tuple[str, list[tuple[float, str]]]:
     name, units = LABELS.get(settings["quantity"], (settings["quantity"], ""))
     lo, hi = settings["limits"]
     title = f"{name} ({units})"
+    if settings.get("part"):
+        title = f"{settings['part']} (own limits): {title}"
     if settings.get("quantity") == "zebra":
         title = f"{name} ({units})" + (f": {settings['sign_convention']}" if settings.get("sign_convention") else "")
     elif settings.get("percentile", 100) < 100:
@@ -354,7 +364,8 @@ def build_legend(registry_or_collection, settings: dict, placement: Matrix, widt
         collection.objects.link(obj)
         return obj
 
-    bar = obtain((tag, "bar"), "Review legend bar", _new_mesh)
+    prefix = "Review legend" if tag == "legend" else f"Review {tag}"
+    bar = obtain((tag, "bar"), f"{prefix} bar", _new_mesh)
     _write_mesh(bar.data, verts, quads, colours)
     bar.matrix_world = placement
     objects.append(bar)
@@ -366,12 +377,12 @@ def build_legend(registry_or_collection, settings: dict, placement: Matrix, widt
         x = min(max(x, 0.0), width - 0.54 * size * len(label))
         texts.append((label, Matrix.Translation((x, -1.0 * size, 0.0))))
     for i, (body, offset) in enumerate(texts):
-        obj = obtain((tag, "text", i), f"Review legend text {i}", None if registry else (lambda nm: None))
+        obj = obtain((tag, "text", i), f"{prefix} text {i}", None if registry else (lambda nm: None))
         if obj.type != "MESH" or obj.data is None:
             # a fresh object without data: give it a text mesh (objects cannot change type)
             bpy.data.objects.remove(obj)
-            mesh = _text_mesh(body, f"Review legend text {i}", size)
-            obj = bpy.data.objects.new(f"Review legend text {i}", mesh)
+            mesh = _text_mesh(body, f"{prefix} text {i}", size)
+            obj = bpy.data.objects.new(f"{prefix} text {i}", mesh)
             if registry:
                 obj[ROLE_KEY] = json.dumps([tag, "text", i])
                 registry.existing[(tag, "text", i)] = obj
@@ -528,25 +539,14 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
             normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
             computed[k] = c[:5] + (replace(c[5], values=zebra_values(normals, view, axis), quantity="zebra"),)
     maps = [c for c in computed if c[5] is not None]
-    # the hub's curvature (nose, tail, fillets) would set the limits: leave it out of them
-    counted = [c for c in maps if opt.include_hub or not is_hub(c[1])] or maps
-    excluded = sorted({c[1].name for c in maps if c not in counted})
-    values = [c[5].values for c in counted]
-    if values:
-        areas = [c[5].vertex_areas() for c in counted]
-        if opt.quantity == "zebra":
-            limits = (0.0, 1.0)
-        elif opt.quantity in NON_NEGATIVE:
-            limits = (0.0, opt.limit) if opt.limit > 0 else upper_limit(values, opt.percentile, areas)
-        else:
-            limits = (-opt.limit, opt.limit) if opt.limit > 0 else symmetric_limits(values, opt.percentile, areas)
-        v_all = np.concatenate([v.ravel() for v in values])
-        a_all = np.concatenate([a.ravel() for a in areas])
-        outside = (v_all < limits[0]) | (v_all > limits[1])
-        clipped = float(a_all[outside].sum() / max(a_all.sum(), 1e-300))  # fraction of the area
-    else:
-        limits = (-1.0, 1.0)
-        clipped = 0.0
+    # the hub's curvature (nose, tail, fillets) would set the limits and wash the blade
+    # out: the blade alone sets them; an included hub gets limits of its own
+    counted = [c for c in maps if not is_hub(c[1])] or maps
+    hubs = [c for c in maps if c not in counted]
+    excluded = [] if opt.include_hub else sorted({c[1].name for c in hubs})
+    own = hubs if opt.include_hub else []
+    limits, clipped = _colour_limits(counted, opt)
+    hub_limits, hub_clipped = _colour_limits(own, opt) if own else (None, 0.0)
     # combs: iso lines of surfaces and the curves themselves, one scale for all
     raw_combs = []
     teeth = max(int(opt.comb_teeth), 2)
@@ -595,17 +595,24 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
                                     "reference": opt.reference, "excluded_from_limits": excluded,
                                     "samples_per_span": opt.samples_per_span,
                                     "sign_convention": sign_convention(opt.quantity, opt.convex_positive)})
+    if hub_limits is not None:
+        # an included hub: coloured on its own limits, drawn in its own panel and legend
+        result.settings.update(hub=sorted({c[1].name for c in own}), hub_limits=list(hub_limits),
+                               hub_clipped=hub_clipped)
     shift = {"source": Vector((0.0, 0.0, 0.0)), "reference": Vector((-spacing, 0.0, 0.0))}
     result.settings["spacing"] = spacing
     # one colour scale for every deviation map, so they compare with each other
-    dlim = symmetric_limits(list(deviation.values()), 100.0) if deviation else None
+    # (a hub's deviation, like its curvature, does not set the blade's scale)
+    blade_dev = [d for (name, _), d in deviation.items() if not is_hub(bpy.data.objects.get(name))]
+    dlim = symmetric_limits(blade_dev or list(deviation.values()), 100.0) if deviation else None
     if dlim is not None:
         result.settings["deviation_limits"] = list(dlim)
     for role, owner, objs, entity, index, m in maps:
         offset = DISPLAY_OFFSET_FRACTION * max(entity.size(), 1e-12)
         verts = (m.points + offset * m.curvature.normal).reshape(-1, 3)
         quads = m.quads()
-        colours = colours_for(m.values.ravel(), limits, opt.quantity)
+        colours = colours_for(m.values.ravel(), hub_limits if hub_limits is not None and is_hub(owner) else limits,
+                              opt.quantity)
         first = None
         for k, obj in enumerate(objs):
             name = f"{obj.name} map" + (f" {index}" if index else "")
@@ -649,6 +656,9 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
         placement = Matrix.Translation((lo_corner[0], lo_corner[1], lo_corner[2] - 0.15 * size)) @ Matrix.Rotation(
             math.pi / 2, 4, "X")
         build_legend(registry, result.settings, placement, width)
+        if hub_limits is not None:
+            build_legend(registry, hub_legend_settings(result.settings),
+                         Matrix.Translation((0.0, 0.0, -0.12 * size)) @ placement, width, tag="hub legend")
     registry.prune()
     coll[SETTINGS_KEY] = json.dumps(result.settings)
     result.numbers = {f"{k[0]}" + (f" [{k[1]}]" if k[1] else ""): v for k, v in numbers.items()}
@@ -656,6 +666,26 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
     times["total"] = time.perf_counter() - clock
     result.times = times
     return result
+
+
+def _colour_limits(maps, opt: ReviewOptions) -> tuple[tuple, float]:
+    """Colour limits of the computed ``maps`` (zebra 0..1, 0..hi for never-negative
+    quantities, symmetric otherwise; ``opt.limit`` or the area percentile) and the
+    fraction of their area beyond them."""
+    values = [c[5].values for c in maps]
+    if not values:
+        return (-1.0, 1.0), 0.0
+    areas = [c[5].vertex_areas() for c in maps]
+    if opt.quantity == "zebra":
+        limits = (0.0, 1.0)
+    elif opt.quantity in NON_NEGATIVE:
+        limits = (0.0, opt.limit) if opt.limit > 0 else upper_limit(values, opt.percentile, areas)
+    else:
+        limits = (-opt.limit, opt.limit) if opt.limit > 0 else symmetric_limits(values, opt.percentile, areas)
+    v_all = np.concatenate([v.ravel() for v in values])
+    a_all = np.concatenate([a.ravel() for a in areas])
+    outside = (v_all < limits[0]) | (v_all > limits[1])
+    return limits, float(a_all[outside].sum() / max(a_all.sum(), 1e-300))  # fraction of the area
 
 
 def _rescale(comb, scale: float):
@@ -873,6 +903,9 @@ def _settings_line(settings: dict) -> str:
              f"{settings.get('samples_per_span', DEFAULT_SAMPLES_PER_SPAN)} samples per knot span"]
     if settings.get("excluded_from_limits"):
         parts.append("hub not counted in the limits (and not drawn)")
+    if settings.get("hub_limits"):
+        lo, hi = settings["hub_limits"]
+        parts.append(f"hub: own panel and limits [{lo:.3g}, {hi:.3g}]")
     return "; ".join(p for p in parts if p)
 
 
@@ -918,6 +951,32 @@ def _wind_views(maps, panel_px: int) -> list[dict] | None:
                           "resolution": (width_px, height_px), "span": span, "side": side * side_sign,
                           "row": True})
     return views
+
+
+def _hub_view(hub_maps, width_px: int, panel_px: int) -> dict:
+    """A side view of a propeller hub: looking at it across its axis (the root Empty's
+    local z, drawn left to right) from the side of the reference blade, in a strip of the
+    image's width, framed on the hub's maps."""
+    P, _, _ = _map_points(hub_maps)
+    root = _root_of(_source_of(hub_maps[0]))
+    M = np.array(root.matrix_world) if root is not None else np.eye(4)
+    axis = M[:3, 2] / np.linalg.norm(M[:3, 2])
+    centre = P.mean(axis=0)
+    radial = centre - M[:3, 3]
+    radial -= axis * np.dot(radial, axis)
+    if np.linalg.norm(radial) < 1e-9 * np.ptp(P @ axis):  # a whole hub: any side
+        radial = M[:3, 0] - axis * np.dot(M[:3, 0], axis)
+    radial /= np.linalg.norm(radial)
+    up = np.cross(radial, axis)
+    ext_h, ext_v = np.ptp(P @ axis), np.ptp(P @ up)
+    mid = axis * 0.5 * ((P @ axis).max() + (P @ axis).min()) + up * 0.5 * ((P @ up).max() + (P @ up).min()) \
+        + radial * float(np.mean(P @ radial))
+    res_x = int(width_px)
+    res_y = int(np.clip(round(res_x * 1.35 * ext_v / max(1.15 * ext_h, 1e-12)), panel_px // 2, panel_px))
+    scale = max(1.15 * ext_h, 1.35 * ext_v * res_x / res_y)
+    return {"title": "hub, on its own colour limits (legend below)", "centre": mid,
+            "matrix": _look_at(mid + radial * 4.0 * scale, mid, up), "ortho_scale": scale,
+            "resolution": (res_x, res_y), "row": True}
 
 
 def _overlay_objects(view, landmarks: dict, centre: np.ndarray, made_meshes: list, tag: str) -> list:
@@ -1013,13 +1072,20 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
     # a propeller's hub is not drawn when it does not count for the limits: clipped, it
     # would only hide the blade root
     hub_hidden = bool(settings.get("excluded_from_limits"))
+    # an included hub has limits of its own: it gets its own panel and legend below the
+    # blade's, which keep the blade's limits
+    hub_maps = []
+    if settings.get("hub_limits"):
+        hub_maps = [o for o in maps if is_hub(_source_of(o))]
+        hub_hidden = hub_hidden or bool(hub_maps)
     if hub_hidden:
         maps = [o for o in maps if not is_hub(_source_of(o))] or maps
     # a propeller's other blades are linked copies of the reference blade: same colours,
     # and in the framed views they would only cover its root
     maps = [o for o in maps if _source_of(o) is None or int(_source_of(o).get("bladesmith_blade", 0)) == 0] or maps
     before = [o for o, r in roles if r[0] == "map" and r[1] == "reference"]
-    after_dev = [o for o, r in roles if r[0] == "deviation"]
+    after_dev = [o for o, r in roles if r[0] == "deviation"
+                 and not (hub_hidden and is_hub(bpy.data.objects.get(r[1]) if len(r) > 1 else None))]
     columns = [("", maps, 0.0)]
     if hub_hidden:
         before = [o for o in before if not is_hub(_source_of(o))]
@@ -1044,6 +1110,7 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
         _source_of(o) is not None and _source_of(o).get("bladesmith_part") == "blade" for o in maps)
     propeller_edges = _propeller_edges(maps)
     made_objects, made_meshes = [], []
+    layout = {}  # pixel rows (from the top) of the hub's panel and the legends' limits
     temp = bpy.data.scenes.new("Bladesmith review render")
     world = bpy.data.worlds.new("Bladesmith review world")
     camera_data = bpy.data.cameras.new("Bladesmith review camera")
@@ -1081,6 +1148,11 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
                     copy.matrix_world = obj.matrix_world
                     made_objects.append(copy)
                     copies[obj.name] = copy
+        for obj in hub_maps:
+            copy = bpy.data.objects.new(obj.name + " render", obj.data)
+            copy.matrix_world = obj.matrix_world
+            made_objects.append(copy)
+            copies[obj.name] = copy
 
         def clear_scene():
             for obj in list(temp.collection.objects):
@@ -1132,14 +1204,34 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
                 rows[0].extend(panels)
             else:
                 rows.append(panels)
+        total_w = max(sum(p.shape[1] for p in row) for row in rows)
+        hub_row = None
+        if hub_maps:
+            clear_scene()
+            for obj in hub_maps:
+                temp.collection.objects.link(copies[obj.name])
+            hub_view = _hub_view(hub_maps, total_w, panel_size)
+            temp.render.resolution_x, temp.render.resolution_y = hub_view["resolution"]
+            camera_data.ortho_scale = hub_view["ortho_scale"]
+            camera_data.clip_start = 1e-3 * hub_view["ortho_scale"]
+            camera_data.clip_end = 100.0 * hub_view["ortho_scale"]
+            overlays = _overlay_objects(hub_view, {}, hub_view["centre"], made_meshes, "Bladesmith review hub")
+            for obj in overlays:
+                temp.collection.objects.link(obj)
+            made_objects.extend(overlays)
+            cam.matrix_world = hub_view["matrix"]
+            path = os.path.join(folder, "hub.png")
+            _render(temp, path)
+            hub_row = _read_png(path)
         times["views"] = time.perf_counter() - clock - times["review"]
         # legend(s) and title strip: their own small renders, far from the maps
-        total_w = max(sum(p.shape[1] for p in row) for row in rows)
         # the sign convention is in the heading; the legend keeps name, units and limits
         legends = [{k: v for k, v in settings.items() if k != "sign_convention"}]
         if len(columns) > 1 and settings.get("deviation_limits"):
             legends.append({"quantity": "deviation", "limits": settings["deviation_limits"], "percentile": 100.0,
                             "sign_convention": "positive: outside the reference"})
+        if hub_row is not None:
+            legends.append(hub_legend_settings(legends[0] | {"hub_limits": settings["hub_limits"]}))
         strips = []
         width = 1.0
         for k, legend_settings in enumerate(legends):
@@ -1179,8 +1271,22 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
                 row[:, x - 1 : x + 1, :3] = 0.6
             row[:2, :, :3] = 0.6
             body_rows.append(row)
-        # image rows run bottom-up: legends, the views (last view lowest), heading on top
-        image = np.concatenate(list(reversed(strips)) + list(reversed(body_rows)) + [heading], axis=0)
+        # top to bottom: heading, the views, their legend(s); an included hub's panel and
+        # its legend last (image rows run bottom-up, hence the reversal)
+        blocks = [heading] + body_rows + strips[: len(strips) - (hub_row is not None)]
+        if hub_row is not None:
+            if hub_row.shape[1] < total_w:
+                pad = np.ones((hub_row.shape[0], total_w - hub_row.shape[1], 4), dtype=hub_row.dtype)
+                hub_row = np.concatenate([hub_row, pad], axis=1)
+            hub_row[-3:, :, :3] = 0.3  # a darker rule: a panel on other limits starts here
+            top = sum(b.shape[0] for b in blocks)
+            layout["hub"] = {"rows": [top, top + hub_row.shape[0]], "limits": settings["hub_limits"],
+                             "names": settings.get("hub", [])}
+            blocks += [hub_row, strips[-1]]
+        layout["legends"] = [{"part": s.get("part", "blade" if hub_row is not None and s["quantity"] != "deviation"
+                                            else ""),
+                              "quantity": s["quantity"], "limits": list(s["limits"])} for s in legends]
+        image = np.concatenate(list(reversed(blocks)), axis=0)
         _write_png(image, filepath)
         times["legend_and_write"] = time.perf_counter() - clock - times["review"] - times["views"]
     finally:
@@ -1197,7 +1303,8 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
             os.remove(os.path.join(folder, name))
         os.rmdir(folder)
     times["total"] = time.perf_counter() - clock
-    return {"filepath": filepath, "views": [v["title"] for v in views], "times": times}
+    return {"filepath": filepath, "views": [v["title"] for v in views] + (["hub"] if hub_maps else []),
+            "times": times, **layout}
 
 
 def _render_strip(temp, cam, camera_data, folder, name, width_px, height_px, content_h, content_w, centre,
@@ -1244,9 +1351,10 @@ class BLADESMITH_OT_curvature_review(bpy.types.Operator):
     comb_inside: BoolProperty(name="Teeth Inside", default=False,
                               description="Draw teeth towards the centre of curvature (default: convex side)")
     envelope: BoolProperty(name="Envelope", default=True)
-    include_hub: BoolProperty(name="Hub in Limits", default=False,
-                              description="Let a propeller hub's curvature count for the colour limits "
-                                          "(off: the blade sets them, the hub is clipped)")
+    include_hub: BoolProperty(name="Include Hub", default=False,
+                              description="Review a propeller hub on colour limits of its own (its own panel and "
+                                          "legend; the blade keeps its limits). Off: the hub is left out of the "
+                                          "limits and not drawn in the image")
     iso_lines: IntProperty(name="Counted Iso Lines", default=11, min=0, max=200)
     reference: StringProperty(name="Reference", default="",
                               description="Object or collection before smoothing: same limits, and a difference map")
@@ -1281,7 +1389,9 @@ class BLADESMITH_OT_curvature_review(bpy.types.Operator):
             wm.progress_update(1)
             if path:
                 try:
-                    render_review_image([], path, scene=context.scene, review=False)
+                    info = render_review_image([], path, scene=context.scene, review=False)
+                    review_collection(context.scene)[IMAGE_KEY] = json.dumps(
+                        {k: v for k, v in info.items() if k != "times"})
                 except OSError as exc:
                     raise GeometryError(f"cannot write the review image {path!r}: {exc.strerror or exc}") from None
         except BladesmithError as error:
@@ -1293,8 +1403,11 @@ class BLADESMITH_OT_curvature_review(bpy.types.Operator):
         if space is not None and space.type == "VIEW_3D":
             space.shading.color_type = "VERTEX"  # show the colour attribute in Solid mode
         lo, hi = result.settings["limits"]
+        hub = ""
+        if result.settings.get("hub_limits"):
+            hub = f" (hub on its own limits, up to {result.settings['hub_limits'][1]:.3g})"
         self.report({"INFO"}, f"reviewed {len(result.maps)} maps, {len(result.combs)} comb objects; "
-                              f"limits ±{hi:.3g}, {result.times['total'] * 1e3:.0f} ms")
+                              f"limits ±{hi:.3g}{hub}, {result.times['total'] * 1e3:.0f} ms")
         return {"FINISHED"}
 
 

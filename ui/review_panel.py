@@ -35,6 +35,9 @@ class BLADESMITH_PT_curvature_review(bpy.types.Panel):
                 layout.label(text=settings["sign_convention"])
             if settings.get("excluded_from_limits"):
                 layout.label(text="not in the limits: " + ", ".join(settings["excluded_from_limits"]))
+            if settings.get("hub_limits"):
+                lo, hi = settings["hub_limits"]
+                layout.label(text=f"hub on its own limits [{lo:.3g}, {hi:.3g}]")
         for obj in sorted(coll.objects, key=lambda o: o.name):
             text = obj.get(NUMBERS_KEY)
             if not text:

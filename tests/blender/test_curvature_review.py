@@ -150,8 +150,14 @@ def test_hub_left_out_of_the_limits_and_sequential_map(scene):
     alone = cr.review_objects(scene, [blade], comb_lines=0).settings["limits"]
     both = cr.review_objects(scene, [blade, hub], comb_lines=0).settings
     assert both["limits"] == pytest.approx(alone) and both["excluded_from_limits"] == ["Hub"]
-    included = cr.review_objects(scene, [blade, hub], comb_lines=0, include_hub=True).settings["limits"]
-    assert included[1] > 3 * alone[1]
+    included = cr.review_objects(scene, [blade, hub], comb_lines=0, include_hub=True).settings
+    # included, the hub gets limits of its own; the blade keeps the blade's
+    assert included["limits"] == pytest.approx(alone) and included["excluded_from_limits"] == []
+    assert included["hub"] == ["Hub"] and included["hub_limits"][1] > 3 * alone[1]
+    # nor does the hub's deviation from a reference set the deviation scale
+    surface_to_object(bump_surface(0.052), "Before")
+    compared = cr.review_objects(scene, [blade, hub], comb_lines=0, reference="Before").settings
+    assert compared["deviation_max"] > 0.1 and compared["deviation_limits"][1] <= 0.002 + 1e-6
     energy = cr.review_objects(scene, [blade], quantity="strain_energy", comb_lines=0)
     lo, hi = energy.settings["limits"]
     assert lo == 0.0 and hi > 0.0
@@ -171,4 +177,50 @@ def test_zebra_quantity(scene):
     v = np.zeros(len(mesh.vertices), dtype=np.float32)
     mesh.attributes[cr.VALUE_ATTRIBUTE].data.foreach_get("value", v)
     assert v.min() < 0.05 and v.max() > 0.95  # dark and light stripes over the bump
+    cr.clear_review(scene)
+
+
+def test_included_hub_gets_its_own_panel_and_limits(scene, tmp_path):
+    """DTMB 4119 with include_hub=True: the blade's limits are those without the hub, and
+    the image shows the hub in a panel of its own with its own legend (issue 21)."""
+    assert bpy.ops.bladesmith.add_propeller(preset="DTMB4119") == {"FINISHED"}
+    root = next(o for o in scene.objects if o.parent is None)
+    root.select_set(True)
+    bpy.context.view_layer.objects.active = root
+    coll_settings = lambda: json.loads(bpy.data.collections[cr.REVIEW_COLLECTION][cr.SETTINGS_KEY])  # noqa: E731
+    assert bpy.ops.bladesmith.curvature_review(comb_lines=0) == {"FINISHED"}
+    blade_alone = coll_settings()["limits"]
+    path = tmp_path / "hub.png"
+    assert bpy.ops.bladesmith.curvature_review(comb_lines=0, include_hub=True, filepath=str(path)) == {"FINISHED"}
+    coll = bpy.data.collections[cr.REVIEW_COLLECTION]
+    settings = coll_settings()
+    assert settings["limits"] == pytest.approx(blade_alone)
+    hub_limits = settings["hub_limits"]
+    assert settings["hub"] == ["DTMB 4119 hub"] and abs(hub_limits[1] - blade_alone[1]) > 0.05 * blade_alone[1]
+    layout = json.loads(coll[cr.IMAGE_KEY])
+    assert layout["views"][-1] == "hub"
+    assert [(g["part"], g["limits"]) for g in layout["legends"]] == [("blade", pytest.approx(blade_alone)),
+                                                                     ("hub", pytest.approx(hub_limits))]
+    # the hub map's colours are those of its own limits, not the blade's
+    hub_mesh = coll.objects["DTMB 4119 hub map"].data
+    n = len(hub_mesh.vertices)
+    values, colours = np.zeros(n, dtype=np.float32), np.zeros(4 * n, dtype=np.float32)
+    hub_mesh.attributes[cr.VALUE_ATTRIBUTE].data.foreach_get("value", values)
+    hub_mesh.color_attributes[cr.COLOUR_ATTRIBUTE].data.foreach_get("color", colours)
+    own = cr._srgb_to_linear(cr.colours_for(values.astype(np.float64), tuple(hub_limits), "mean"))
+    assert np.allclose(colours.reshape(-1, 4), own, atol=1e-4)
+    # the hub's panel in the image holds the coloured hub (orange: convex) below the blade's
+    img = bpy.data.images.load(str(path))
+    try:
+        w, h = img.size
+        px = np.zeros(w * h * 4, dtype=np.float32)
+        img.pixels.foreach_get(px)
+        px = px.reshape(h, w, 4)[::-1, :, :3]  # rows from the top
+    finally:
+        bpy.data.images.remove(img)
+    top, bottom = layout["hub"]["rows"]
+    assert 0 < top < bottom < h and layout["hub"]["limits"] == pytest.approx(hub_limits)
+    panel = px[top:bottom]
+    coloured = (panel[..., 0] - panel[..., 2]) > 0.2
+    assert coloured.mean() > 0.1
     cr.clear_review(scene)
