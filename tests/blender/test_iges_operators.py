@@ -343,3 +343,27 @@ def test_exported_files_read_cleanly_in_opencascade(scene, tmp_path, case):
     result = occ.read_with_occ(path)
     assert result.load_messages == [] and result.transfer_messages == []
     assert result.faces and all(occ.is_valid(face) for face in result.faces)
+
+
+@pytest.mark.parametrize("scale", [-2.0, 0.0])
+def test_model_space_scale_that_mirrors_or_vanishes_is_refused_through_the_operator(scene, tmp_path, scale):
+    """Issue 20: a model scale of -2 used to mirror silently and 0 was taken as 1; the
+    import operator refuses both, naming the field and value, and changes nothing."""
+    import importlib.util
+    import sys
+
+    cases_path = pathlib.Path(__file__).resolve().parents[1] / "unit" / "import_cases.py"
+    if "import_cases" not in sys.modules:
+        spec = importlib.util.spec_from_file_location("import_cases", cases_path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules["import_cases"] = module
+        spec.loader.exec_module(module)
+    cases = sys.modules["import_cases"]
+    path = tmp_path / "scaled.igs"
+    path.write_text(cases.set_global(cases.line_file(), model_scale=scale))
+    rng = np.random.default_rng(20)
+    surface_to_object(random_surface(rng, False), "Existing")
+    before = scene_snapshot()
+    with pytest.raises(RuntimeError, match=r"Global field 13 \(model space scale\) = " + str(scale).replace(".", r"\.")):
+        bpy.ops.import_scene.iges(filepath=str(path))
+    assert scene_snapshot() == before
