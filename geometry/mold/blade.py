@@ -39,6 +39,8 @@ from .sections import (
     TwoPartFit,
     aligned_parameters,
     default_knots,
+    densified,
+    densified_section,
     fit_single,
     fit_two_part,
     section_points,
@@ -47,6 +49,8 @@ from .sections import (
 
 #: Upper limit of the control points per half when raising them to meet the tolerance.
 MAX_CONTROL_POINTS = 60
+#: Upper limit of the control points per half of the densified fit (:func:`_fit_dense`).
+MAX_DENSE_CONTROL_POINTS = 160
 #: Step of the control-point count between attempts.
 CONTROL_POINT_STEP = 2
 #: Samples per knot span for the parting-line continuity measurements.
@@ -92,6 +96,9 @@ class BladeMolds:
     aligned_parameters: bool = False
     #: Per station: the tolerance (chord fraction) it was fitted to.
     tolerances: np.ndarray | None = None
+    #: The fits approximate each section's interpolant (:func:`.sections.densified`) on a
+    #: knot vector refined where a station missed its tolerance (:func:`_fit_dense`).
+    densified: bool = False
 
     @property
     def surfaces(self) -> dict:
@@ -147,13 +154,17 @@ class StationFitError(GeometryError):
         self.station = station
 
 
-def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None):
+def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None, knots=None):
     """Every section on the common knots (Hosseini §3) with G1 at S (§4): free SQP fits of
     the aero sections give the ratio ρ, then all are refitted with λ_u = ρ λ_l. align:
     parameters of :func:`.sections.aligned_parameters`. magnitudes: (λ_u, λ_l) by hand, in
-    chords (each station's derivative at S is λ × its chord)."""
-    Ku = common_knots([splits[k].upper for k in aero], n, degree)
-    Kl = common_knots([splits[k].lower for k in aero], n, degree)
+    chords (each station's derivative at S is λ × its chord). knots: (upper, lower) knot
+    vectors instead of the averaged ones for ``n``."""
+    if knots is None:
+        Ku = common_knots([splits[k].upper for k in aero], n, degree)
+        Kl = common_knots([splits[k].lower for k in aero], n, degree)
+    else:
+        Ku, Kl = (np.asarray(K, dtype=np.float64) for K in knots)
 
     def params(k):
         if not align:
@@ -469,6 +480,9 @@ def _why(defn: BladeDefinition, k: int) -> str:
     return "; ".join(notes)
 
 
+_MODE_NOTE = {True: ", aligned parameters", "dense": ", densified data, refined knots"}
+
+
 def _no_fit_message(defn: BladeDefinition, attempts: list, tols: np.ndarray) -> str:
     """Which station, why, and the nearest setting that builds (issue 19, item 2)."""
     measured = [a for a in attempts if a[2] is not None]
@@ -480,7 +494,7 @@ def _no_fit_message(defn: BladeDefinition, attempts: list, tols: np.ndarray) -> 
         reach = float(np.max(worst / tols))
         msg = (f"station {k} (r = {st.r:g} m, airfoil {st.airfoil_name or st.airfoil.name!r}) cannot be fitted within "
                f"its tolerance {tols[k]:g} chord: the best fit ({n} control points per half"
-               f"{', aligned parameters' if align else ''}) deviates {worst[k]:.3g} chord")
+               f"{_MODE_NOTE.get(align, '')}) deviates {worst[k]:.3g} chord")
         if why:
             msg += f" ({why})"
         fixes = [f"tolerance = {float(np.max(worst)) * 1.01:.2g} (or this station's tolerance {worst[k] * 1.01:.2g}) "
@@ -520,19 +534,75 @@ def _next_step(n: int, attempts: list) -> int:
     return int(min(MAX_CONTROL_POINT_JUMP, steps * CONTROL_POINT_STEP))
 
 
+def _refined_knots(splits, fits, knots, tols, chords, degree):
+    """(upper, lower) knot vectors with the midpoint of every knot span that holds a data
+    point farther than its station's tolerance from its fitted half inserted (one common
+    insertion for all stations, so the sections stay compatible, Hosseini §3). The
+    error-bounded approximation of NURBS Book §9.4.1 places knots where the error is;
+    here the spans with misses are halved."""
+    new = ([], [])
+    for k, (sp, f) in enumerate(zip(splits, fits)):
+        tol = tols[k] * chords[k]
+        if f.max_residual <= tol:
+            continue
+        for h, (curve, P, marks) in enumerate(((f.upper, sp.upper, sp.upper_marks), (f.lower, sp.lower, sp.lower_marks))):
+            K = knots[h]
+            t = parameterize(P)[marks]
+            d = closest_point_curve(curve, P[marks])[1]
+            spans = np.clip(np.searchsorted(K, t[d > tol], side="right") - 1, degree, len(K) - degree - 2)
+            new[h].extend(0.5 * (K[spans] + K[spans + 1]))
+    return tuple(np.sort(np.concatenate([K, np.unique(x)])) for K, x in zip(knots, new))
+
+
+def _fit_dense(defn: BladeDefinition, splits, n: int, tols: np.ndarray, degree: int, magnitudes, attempts: list):
+    """The fallback of :func:`fit_sections` when the data cannot carry the control points
+    the tolerance needs: every section replaced by samples of its C2 interpolant
+    (:func:`.sections.densified`; the deviation still measured at the original points),
+    the averaged knots for ``n`` (Hosseini §3), then the spans where a station misses its
+    tolerance halved (:func:`_refined_knots`) until every station is within it or the
+    count reaches :data:`MAX_DENSE_CONTROL_POINTS`. Returns (fits, ρ, count) or None."""
+    dense = [densified(s) for s in splits]
+    aero = list(range(defn.first_aerodynamic_station, len(defn.stations)))
+    chords = np.array([s.chord for s in defn.stations])
+    knots = (common_knots([dense[k].upper for k in aero], n, degree),
+             common_knots([dense[k].lower for k in aero], n, degree))
+    while True:
+        count = max(len(K) - degree - 1 for K in knots)
+        try:
+            fits, rho = _fit_all(dense, aero, n, degree, defn, False, magnitudes, knots)
+        except StationFitError as exc:
+            attempts.append((count, "dense", None, exc))
+            return None
+        worst = _deviations(dense, fits, chords, tols)
+        attempts.append((count, "dense", worst, tols))
+        if np.all(worst <= tols):
+            return fits, rho, count
+        if count >= MAX_DENSE_CONTROL_POINTS:
+            return None
+        knots = _refined_knots(dense, fits, knots, tols, chords, degree)
+        over = max(len(K) - degree - 1 for K in knots) - MAX_DENSE_CONTROL_POINTS
+        if over > 0:
+            return None
+
+
 def fit_sections(defn: BladeDefinition, splits, n: int, tols: np.ndarray, degree: int = SECTION_DEGREE,
                  adapt: bool = True, magnitudes=None):
     """The section fits on common knots, the control-point count raised by
     :data:`CONTROL_POINT_STEP` (with ``adapt``) until every station k lies within
     ``tols[k]`` × chord. At each count the paper's chord-length parameters are tried
-    first, then :func:`.sections.aligned_parameters`. Returns (fits, ρ, n, aligned,
-    attempts); raises GeometryError naming the station, the cause and the nearest setting
-    that builds (:func:`_no_fit_message`). attempts: (n, aligned, deviations, tolerances)
-    of every measured try, (n, aligned, None, error) of a try whose fit failed."""
+    first, then :func:`.sections.aligned_parameters`. When the data cannot carry the
+    count (the plain fit is rank deficient) or the count reaches
+    :data:`MAX_CONTROL_POINTS`, the densified fit :func:`_fit_dense` takes over from the
+    best count measured. Returns (fits, ρ, n, mode, attempts), mode False (plain), True
+    (aligned) or "dense"; raises GeometryError naming the station, the cause and the
+    nearest setting that builds (:func:`_no_fit_message`). attempts: (n, mode,
+    deviations, tolerances) of every measured try, (n, mode, None, error) of a try whose
+    fit failed."""
     aero = list(range(defn.first_aerodynamic_station, len(defn.stations)))
     chords = np.array([s.chord for s in defn.stations])
     attempts = []
     while True:
+        short = False
         for align in (False, True):
             plain = attempts[-1] if align else None
             if plain is not None and plain[2] is not None and np.max(plain[2] / tols) > ALIGN_RATIO:
@@ -541,11 +611,19 @@ def fit_sections(defn: BladeDefinition, splits, n: int, tols: np.ndarray, degree
                 fits, rho = _fit_all(splits, aero, n, degree, defn, align, magnitudes)
             except StationFitError as exc:
                 attempts.append((n, align, None, exc))
+                short = short or not align
                 continue
             worst = _deviations(splits, fits, chords, tols)
             attempts.append((n, align, worst, tols))
             if np.all(worst <= tols):
                 return fits, rho, n, align, attempts
+        if adapt and (short or n >= MAX_CONTROL_POINTS):
+            measured = [a for a in attempts if a[2] is not None]
+            start = min(measured, key=lambda a: float(np.max(a[2] / tols)))[0] if measured else n
+            dense = _fit_dense(defn, splits, start, tols, degree, magnitudes, attempts)
+            if dense is not None:
+                return dense[0], dense[1], dense[2], "dense", attempts
+            raise GeometryError(_no_fit_message(defn, attempts, tols))
         if not adapt or n >= MAX_CONTROL_POINTS:
             raise GeometryError(_no_fit_message(defn, attempts, tols))
         n = min(MAX_CONTROL_POINTS, n + _next_step(n, attempts))
@@ -596,7 +674,8 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
     tick(0.15)
 
     t0 = time.perf_counter()
-    fits, rho, n, aligned, attempts = fit_sections(defn, splits, n, tols, degree, adapt, tangent_magnitudes)
+    fits, rho, n, mode, attempts = fit_sections(defn, splits, n, tols, degree, adapt, tangent_magnitudes)
+    aligned, dense = mode is True, mode == "dense"
     times["section_fits"] = time.perf_counter() - t0
     tick(0.5)
 
@@ -626,12 +705,14 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
     single_surface = None
     single_fits = {}
     if single:
-        Ks = np.mean([approximation_knots(parameterize(splits[k].points), 2 * n - 1, degree) for k in aero], axis=0)
+        # densified: the single curve approximates the same interpolant samples (errors at the data)
+        whole = {k: densified_section(densified(splits[k])) if dense else (splits[k].points, None) for k in aero}
+        Ks = np.mean([approximation_knots(parameterize(whole[k][0]), 2 * n - 1, degree) for k in aero], axis=0)
         for k in aero:
             try:
-                single_fits[k] = fit_single(splits[k].points, Ks, degree=degree, align=aligned)
+                single_fits[k] = fit_single(whole[k][0], Ks, degree=degree, align=aligned, marks=whole[k][1])
             except BladesmithError:  # the single curve's knot spans differ from the halves'
-                single_fits[k] = fit_single(splits[k].points, Ks, degree=degree, align=not aligned)
+                single_fits[k] = fit_single(whole[k][0], Ks, degree=degree, align=not aligned, marks=whole[k][1])
         curves = [single_fits[k].curve for k in aero]
         v_single = skin_parameters(curves)
         single_surface = skin(curves, degree_v, params=v_single)
@@ -693,7 +774,7 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
     times["fairness"] = time.perf_counter() - t0
     tick(1.0)
     return BladeMolds(defn, upper, lower, single_surface, tr_u, tr_l, parting, reports, n, rho, v, fair,
-                      continuity, times, aligned, tols)
+                      continuity, times, aligned, tols, dense)
 
 
 

@@ -135,7 +135,11 @@ class SplitSection:
     points: (N, 3) the section data (trailing edge upper -> LE -> trailing edge lower).
     upper: (nu, 3) from the upper TE point to S (S last); lower: (nl, 3) from S (first)
     to the lower TE point. upper_data / lower_data: index arrays of the data points in
-    each half (S excluded). tangent: unit C'(u_S) of the preliminary fit, pointing from
+    each half (S excluded). interpolant / u_silhouette: the C2 interpolant of the points
+    the split was found on and S's parameter on it. upper_marks / lower_marks: None when
+    ``upper`` / ``lower`` are the data themselves, else the rows of ``upper`` / ``lower``
+    that are the data points (S excluded), in the order of upper_data / lower_data: the
+    halves of :func:`densified`. tangent: unit C'(u_S) of the preliminary fit, pointing from
     the upper half into the lower one. magnitude_upper / magnitude_lower: |C'| at S scaled
     to each half's [0, 1] parameter: the initial tangent magnitudes. chord: local chord.
     """
@@ -150,6 +154,10 @@ class SplitSection:
     magnitude_upper: float
     magnitude_lower: float
     chord: float
+    interpolant: BSplineCurve | None = None
+    u_silhouette: float = float("nan")
+    upper_marks: np.ndarray | None = None
+    lower_marks: np.ndarray | None = None
 
 
 def split_section(points, chordwise, chord: float, direction=(0.0, 1.0, 0.0), wrap: bool = True,
@@ -170,7 +178,50 @@ def split_section(points, chordwise, chord: float, direction=(0.0, 1.0, 0.0), wr
     return SplitSection(
         points=Q, upper=np.vstack([Q[up], S]), lower=np.vstack([S, Q[lo]]), upper_data=up, lower_data=lo,
         silhouette=S, tangent=dS / speed, magnitude_upper=speed * uS, magnitude_lower=speed * (1.0 - uS), chord=chord,
+        interpolant=prelim, u_silhouette=float(uS),
     )
+
+
+#: Samples per interval between consecutive data points of :func:`densified` (the data
+#: points included): enough that every knot span of a common knot vector up to several
+#: times as many control points as data points still holds data (Schoenberg–Whitney).
+DENSE_SAMPLES = 8
+
+
+def densified(split: SplitSection, samples: int = DENSE_SAMPLES) -> SplitSection:
+    """The split with each half's data replaced by ``samples`` points per data interval of
+    the section's C2 chord-length interpolant (``split.interpolant``, NURBS Book Alg. A9.1,
+    the curve S was found on), the data points themselves among them (``upper_marks`` /
+    ``lower_marks``).
+
+    Why: Hosseini §4 fits each half to its airfoil points within the designer's tolerance
+    per station; with coarse or irregular data (windIO airfoils: ~100 points a side, with
+    corners and 1e-4-chord zig-zags) that tolerance needs about as many control points as
+    there are points, where the least-squares problem (Eq. 3) is ill-posed: knot spans of
+    the common knot vector (§3) hold no data. The interpolant passes through every data
+    point and is the fairest C2 cubic that does (NURBS Book §9.2.1); a least-squares fit of
+    its dense samples is well posed for any count, and its deviation is still measured at
+    the original points only (:func:`~.blade.section_deviation`)."""
+    if split.interpolant is None:
+        raise GeometryError("the split has no interpolant to densify")
+    t = parameterize(split.points)
+    f = np.arange(samples) / samples
+
+    def half(ts, first, last):
+        s = np.concatenate([(a + (b - a) * f) for a, b in zip(ts[:-1], ts[1:])] + [ts[-1:]])
+        P = split.interpolant.evaluate(s)
+        P[0], P[-1] = first, last  # the ends bit for bit: the TE point and S
+        return P
+
+    up = half(np.concatenate([t[split.upper_data], [split.u_silhouette]]), split.upper[0], split.upper[-1])
+    lo = half(np.concatenate([[split.u_silhouette], t[split.lower_data]]), split.lower[0], split.lower[-1])
+    marks_u = np.arange(len(split.upper_data)) * samples
+    marks_l = (np.arange(len(split.lower_data)) + 1) * samples
+    return SplitSection(points=split.points, upper=up, lower=lo, upper_data=split.upper_data,
+                        lower_data=split.lower_data, silhouette=split.silhouette, tangent=split.tangent,
+                        magnitude_upper=split.magnitude_upper, magnitude_lower=split.magnitude_lower,
+                        chord=split.chord, interpolant=split.interpolant, u_silhouette=split.u_silhouette,
+                        upper_marks=marks_u, lower_marks=marks_l)
 
 
 # ---------------------------------------------------------------------------------------
@@ -187,28 +238,68 @@ class _AffineHalf:
     give the objective Σ|Q_r - C(t_r)|² (Hosseini Eq. 3) exactly as a quadratic in λ."""
 
     def __init__(self, points, knots, degree, tangent, at_start: bool, params=None):
-        self.points = points
+        self.points = np.asarray(points, dtype=np.float64)
         self.params = parameterize(points) if params is None else np.asarray(params, dtype=np.float64)
-        self.knots = knots
+        self.knots = np.asarray(knots, dtype=np.float64)
         self.degree = degree
         self.tangent = tangent
         self.at_start = at_start
-        # the fit is affine in λ: two solves give every λ (control points P0 + λ dP), and
-        # one basis matrix gives every residual
-        P0 = self._solve(0.0).control_points
-        self.P0 = np.asarray(P0)
-        self.dP = np.asarray(self._solve(1.0).control_points) - self.P0
-        N = BSpline.design_matrix(self.params, np.asarray(knots, dtype=np.float64), degree)
-        self.r0 = (np.asarray(points) - N @ self.P0).ravel()
+        # the fit is affine in λ: one banded solve with two right-hand sides gives every λ
+        # (control points P0 + λ dP), and one basis matrix gives every residual
+        N = BSpline.design_matrix(self.params, self.knots, degree).tocsc()
+        self.P0, self.dP = self._solve(N)
+        self.r0 = (self.points - N @ self.P0).ravel()
         self.g = -(N @ self.dP).ravel()
 
-    def _solve(self, magnitude: float) -> BSplineCurve:
-        D = magnitude * self.tangent
-        n_control = len(self.knots) - self.degree - 1
-        return fit_least_squares(
-            self.points, n_control, self.degree, params=self.params, knots=self.knots,
-            start_derivative=D if self.at_start else None, end_derivative=None if self.at_start else D,
-        )
+    def _solve(self, N):
+        """P0 and dP of the least-squares fit with P_0 = Q_0, P_n = Q_m and the derivative
+        control point next to S (Piegl & Tiller 2000; NURBS Book Eqs. 9.63–9.67): the
+        normal equations of the free control points (banded, bandwidth p, symmetric
+        positive definite when every free basis function has data: Schoenberg–Whitney)
+        by ``solveh_banded``, both right-hand sides at once."""
+        from scipy.linalg import LinAlgError, solveh_banded
+
+        Q, U, p = self.points, self.knots, self.degree
+        nc = len(U) - p - 1
+        n = nc - 1
+        if nc < max(p + 1, 3):
+            raise GeometryError(f"n_control too small: {nc} for degree {p} with an end derivative")
+        if nc > len(Q):
+            raise GeometryError(f"too few points: {nc} control points need at least {nc} data points, got {len(Q)}")
+        P0 = np.zeros((nc, Q.shape[1]))
+        dP = np.zeros_like(P0)
+        P0[0], P0[n] = Q[0], Q[-1]
+        if self.at_start:
+            j, slope = 1, self.tangent * (U[p + 1] - U[1]) / p
+            P0[1] = Q[0]
+        else:
+            j, slope = n - 1, -self.tangent * (U[n + p] - U[n]) / p
+            P0[n - 1] = Q[-1]
+        dP[j] = slope
+        fixed = np.zeros(nc, dtype=bool)
+        fixed[[0, j, n]] = True
+        free = np.flatnonzero(~fixed)
+        if free.size:
+            rows = N[1:-1]
+            A = rows[:, free]
+            R0 = Q[1:-1] - rows[:, fixed] @ P0[fixed]
+            R1 = -(rows[:, fixed] @ dP[fixed])
+            M = (A.T @ A).todia()
+            band = np.zeros((p + 1, free.size))
+            for off, diag in zip(M.offsets, M.data):
+                if 0 <= off <= p:
+                    band[p - off, off:] = diag[off:]
+            rhs = A.T @ np.hstack([R0, R1])
+            try:
+                X = solveh_banded(band, rhs, check_finite=False)
+            except LinAlgError:
+                X = None
+            if X is None or not np.all(np.isfinite(X)):
+                raise GeometryError("the least-squares system is rank deficient: some knot span holds no data "
+                                    "parameter (Schoenberg–Whitney); use fewer control points or other knots")
+            dim = Q.shape[1]
+            P0[free], dP[free] = X[:, :dim], X[:, dim:]
+        return P0, dP
 
     def _fit(self, magnitude: float) -> BSplineCurve:
         """The constrained fit with derivative magnitude λ at S: P0 + λ dP."""
@@ -322,8 +413,10 @@ def fit_two_part(split: SplitSection, knots_upper=None, knots_lower=None, n_cont
 def _finish(up: _AffineHalf, lo: _AffineHalf, split: SplitSection, lam_u: float, lam_l: float,
             iterations: int) -> TwoPartFit:
     cu, cl = up._fit(lam_u), lo._fit(lam_l)
-    ru = up.residuals(lam_u)[:-1]  # S (interpolated) excluded
-    rl = lo.residuals(lam_l)[1:]
+    # at the data points only (S, interpolated, excluded; densified halves: their marks)
+    ru, rl = up.residuals(lam_u), lo.residuals(lam_l)
+    ru = ru[:-1] if split.upper_marks is None else ru[split.upper_marks]
+    rl = rl[1:] if split.lower_marks is None else rl[split.lower_marks]
     err = float(np.sum(ru**2) + np.sum(rl**2))
     mx = float(max(np.linalg.norm(ru, axis=1).max(), np.linalg.norm(rl, axis=1).max()))
     return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, iterations)
@@ -339,10 +432,12 @@ class SingleFit:
 
 
 def fit_single(points, knots=None, n_control: int = 23, degree: int = SECTION_DEGREE,
-               align: bool = False) -> SingleFit:
+               align: bool = False, marks=None) -> SingleFit:
     """Least-squares fit of the whole section, ends interpolated (NURBS Book §9.4.1), on
     ``knots`` or the approximation knots for ``n_control`` (Eqs. 9.68–9.69); ``align``:
-    the parameters of :func:`aligned_parameters`."""
+    the parameters of :func:`aligned_parameters`. marks: the rows of ``points`` that are
+    data points (densified sections, :func:`densified_section`): the errors are measured
+    there only; default all."""
     Q = np.asarray(points, dtype=np.float64)
     t = parameterize(Q)
     K = approximation_knots(t, n_control, degree) if knots is None else np.asarray(knots)
@@ -350,4 +445,16 @@ def fit_single(points, knots=None, n_control: int = 23, degree: int = SECTION_DE
         t = aligned_parameters(Q, K, degree)
     c = fit_least_squares(Q, len(K) - degree - 1, degree, params=t, knots=K)
     r = _residual(c, Q, t)
+    if marks is not None:
+        r = r[marks]
     return SingleFit(c, float(np.sum(r**2)), float(np.linalg.norm(r, axis=1).max()))
+
+
+def densified_section(split: SplitSection) -> tuple[np.ndarray, np.ndarray]:
+    """(points, marks) of the whole densified section (:func:`densified`): upper half then
+    lower half without its repeated S; marks: the rows that are data points."""
+    if split.upper_marks is None:
+        return split.points, np.arange(len(split.points))
+    P = np.vstack([split.upper, split.lower[1:]])
+    marks = np.concatenate([split.upper_marks, len(split.upper) - 1 + split.lower_marks])
+    return P, marks
