@@ -1,8 +1,10 @@
 """Issue 19, item 3: the IEA 15 MW from its windIO file, molds built and read back.
 
-At tolerance 2e-4 chord the raising loop ends at 60 control points per half with the
-aligned parameters (scripts/wind_acceptance.py shows the whole loop); starting there keeps
-the test short. Every station is within its tolerance, the trailing edge never folds,
+At the default tolerance (1e-4 chord) the coarse windIO airfoils cannot carry the control
+points the tolerance needs (the plain fit turns rank deficient past 32 per half), so the
+build approximates each section's interpolant on common knots refined where a station
+misses (geometry.mold.blade._fit_dense), the deviation measured at the original points.
+Every station is within its tolerance, the trailing edge never folds,
 OpenCASCADE reads the file with 0 messages and the faces sew at 1e-7 × size into one
 shell open only at the root and the tip."""
 from __future__ import annotations
@@ -19,13 +21,15 @@ from bladesmith.iges.mold import write_molds  # noqa: E402
 from occ_support import read_with_occ  # noqa: E402
 
 IEA15 = pathlib.Path(__file__).resolve().parents[3] / "shared" / "data" / "wind" / "IEA-15-240-RWT.yaml"
-TOLERANCE = 2e-4
+TOLERANCE = 1e-4  # the definition's default
 MM_PER_M = 1000.0
 
 
 @pytest.fixture(scope="module")
 def iea(tmp_path_factory):
-    molds = build_blade(load_blade(IEA15), control_points=60, tolerance=TOLERANCE, single=False, fairness=False)
+    defn = load_blade(IEA15)
+    assert defn.tolerance == TOLERANCE
+    molds = build_blade(defn, single=False, fairness=False)
     path = tmp_path_factory.mktemp("iea") / "iea15.igs"
     write_molds(path, molds)
     return molds, read_with_occ(path)
@@ -35,8 +39,9 @@ def test_iea15mw_every_station_within_tolerance(iea):
     molds, _ = iea
     worst = max(r.deviation_two_part for r in molds.stations)
     print(f"\nIEA 15 MW: {len(molds.stations)} stations, {molds.control_points} control points per half, "
-          f"aligned {molds.aligned_parameters}, worst section {worst:.3e} chord")
+          f"aligned {molds.aligned_parameters}, densified {molds.densified}, worst section {worst:.3e} chord")
     assert worst <= TOLERANCE and len(molds.stations) == 51
+    assert all(r.deviation_two_part <= t for r, t in zip(molds.stations, molds.tolerances))
     assert molds.continuity["le_angle_deg"] < 0.01 and molds.continuity["root_angle_deg"] < 0.01
     up, lo = molds.upper, molds.lower
     v = np.linspace(0.0, 1.0, 1000)

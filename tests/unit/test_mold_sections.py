@@ -118,3 +118,30 @@ def test_mold_direction_without_silhouette_names_the_station():
     d["mold_direction"] = [0.0, 0.0, 1.0]
     with pytest.raises(GeometryError, match=r"station 0 \(r = 1 m.*no silhouette"):
         build_blade(blade_from_dict(d))
+
+
+def test_densified_halves_carry_more_control_points_than_data(s823):
+    """Issue 19 (IEA 15 MW): a half with fewer data points than the tolerance needs control
+    points is fitted to samples of the section's interpolant. The samples include every
+    data point (marks) and both ends bit for bit; a count above the number of data points,
+    ill-posed on the data, is well posed on the samples, and its errors are measured at
+    the data points only."""
+    from bladesmith.geometry.mold.blade import section_deviation
+    from bladesmith.geometry.mold.sections import DENSE_SAMPLES, densified
+
+    xy = s823.outline[::4]  # a coarse section: ~40 points a side
+    Q = section_points(xy, 2.0, 0.5, 8.0, 0.3, wrap=True)
+    sp = split_section(Q, xy[:, 0], 0.5, (0.0, 1.0, 0.0), True)
+    dn = densified(sp)
+    assert np.array_equal(dn.upper[0], sp.upper[0]) and np.array_equal(dn.upper[-1], sp.silhouette)
+    assert np.array_equal(dn.lower[0], sp.silhouette) and np.array_equal(dn.lower[-1], sp.lower[-1])
+    assert len(dn.upper) == DENSE_SAMPLES * (len(sp.upper) - 1) + 1
+    assert np.abs(dn.upper[dn.upper_marks] - Q[sp.upper_data]).max() < 1e-13
+    assert np.abs(dn.lower[dn.lower_marks] - Q[sp.lower_data]).max() < 1e-13
+    n = len(sp.upper) + 10
+    with pytest.raises(GeometryError):
+        fit_two_part(sp, n_control=n)
+    fit = fit_two_part(dn, n_control=n)
+    dev = section_deviation(dn, fit)
+    assert dev * sp.chord <= fit.max_residual + 1e-15  # the residual at the data bounds the distance
+    assert dev < 1e-4  # the default tolerance, with more control points than data
