@@ -9,6 +9,8 @@ curvature review image (:func:`bladesmith.operators.curvature_review.render_revi
 - ``review_nrel5mw_molds.png``: the mold halves and root transitions, mean curvature, in
   span segments;
 - ``review_nrel5mw_zebra.png``: the same blade as zebra stripes (reflection lines);
+- ``review_iea15mw_molds.png`` (only with ``--only iea``): the IEA 15 MW mold halves from
+  its windIO file (../shared/data/wind), at the default tolerance, mean curvature;
 - ``review_high_flow.png``: one blade of the high-flow impeller (S, P and LE surfaces),
   mean curvature;
 - ``review_dtmb4119_before_after.png``: the smoothed blade against the unsmoothed one
@@ -30,7 +32,7 @@ from demo import load_addon  # noqa: E402
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default=str(ROOT / "docs"))
-    parser.add_argument("--only", default="", help="comma-separated subset: dtmb,nrel,zebra,impeller,compare")
+    parser.add_argument("--only", default="", help="comma-separated subset: dtmb,nrel,zebra,impeller,compare,iea")
     args = parser.parse_args(argv)
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -84,6 +86,13 @@ def main(argv=None) -> int:
             if not only or "zebra" in only:
                 run("review_nrel5mw_zebra.png", surfaces, "NREL 5-MW blade (preset NREL5MW), mold halves: zebra "
                     "stripes", quantity="zebra", comb_lines=0, samples_per_span=16, panel_size=360)
+        if "iea" in only:
+            fresh()
+            iea = ROOT.parent / "shared" / "data" / "wind" / "IEA-15-240-RWT.yaml"
+            assert bpy.ops.bladesmith.add_wind_blade(definition=str(iea), mold_halves=True) == {"FINISHED"}
+            surfaces = [o for o in bpy.context.scene.objects if o.type == "SURFACE"]
+            run("review_iea15mw_molds.png", surfaces, "IEA 15 MW blade (windIO IEA-15-240-RWT.yaml), mold halves "
+                "(Hosseini 2016), tolerance 1e-4 chord", percentile=95.0, comb_lines=0, panel_size=360)
         if not only or "impeller" in only:
             fresh()
             assert bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False) == {"FINISHED"}
