@@ -51,15 +51,21 @@ def cap_record(cap, scale: float, label: str):
 def closed_blade_records(molds: BladeMolds, units: str = "m", caps: str = "ruled") -> list:
     """The mold surfaces plus root and tip caps (:func:`~bladesmith.geometry.mold.caps.blade_caps`):
     faces that sew into one closed shell. caps: "ruled" (a 128 between the halves' end
-    rows, any section) or "planar" (a trimmed plane whose loop is the end rows themselves;
-    only where the end section is planar)."""
+    rows, any section), "planar" (a trimmed plane whose loop is the end rows themselves;
+    only where the end section is planar) or "rounded" (a planar root, a rounded tip
+    tangent to the mold halves)."""
     from ..geometry.mold.caps import blade_caps
 
     scale = 1.0 / METRES_PER_UNIT[units.lower()]
     root, tip = blade_caps(molds, caps)
     out = mold_records(molds, parting_lines=False, units=units)
-    if caps == "planar":
-        return out + [cap_record(root, scale, "ROOTCAP"), cap_record(tip, scale, "TIPCAP")]
+    from ..geometry.mold.caps import Cap
+
+    if caps in ("planar", "rounded"):
+        def record(cap, label):
+            return cap_record(cap, scale, label) if isinstance(cap, Cap) else surface_from_geometry(cap, scale=scale,
+                                                                                                     label=label)
+        return out + [record(root, "ROOTCAP"), record(tip, "TIPCAP")]
     return out + [surface_from_geometry(root, scale=scale, label="ROOTCAP"),
                   surface_from_geometry(tip, scale=scale, label="TIPCAP")]
 

@@ -569,7 +569,7 @@ def export_molds(settings, filepath: str, progress=None, caps: str = "NONE") -> 
     """Write the shown molds (rebuilt from the last good definition, with the shown
     control-point count, so IGES comes from the float64 model) to ``filepath`` in metres:
     the surfaces as 128, the parting lines as 126; the single surface alone when the
-    halves are off. caps "RULED" or "PLANAR": the closed blade instead, the mold surfaces
+    halves are off. caps "RULED", "PLANAR" or "ROUNDED": the closed blade instead, the mold surfaces
     with root and tip caps (:func:`..iges.mold.write_closed_blade`)."""
     if not settings.definition_toml:
         raise DefinitionError("the wind blade has no generated geometry to export")
@@ -602,7 +602,9 @@ class BLADESMITH_OT_export_wind_blade_iges(_OnRoot, bpy.types.Operator):
                     "mold halves",
         items=[("NONE", "Mold halves (open)", "The mold surfaces and parting lines, open at root and tip"),
                ("RULED", "Closed, ruled caps", "Caps ruled between the halves' end sections (any section)"),
-               ("PLANAR", "Closed, planar caps", "Trimmed planes over the end sections (only planar sections)")],
+               ("PLANAR", "Closed, planar caps", "Trimmed planes over the end sections (only planar sections)"),
+               ("ROUNDED", "Closed, rounded tip", "A planar root (the flange face) and a rounded tip tangent to the "
+                "mold halves")],
         default="NONE",
     )
 

@@ -15,8 +15,16 @@ that plane, trimmed by exactly those rows:
 
 e1 × e2 points out of the blade (away from the tip at the root, away from the root at the
 tip), so the cap's normal is outward like the mold surfaces'. A loop that is not planar
-within ``tol`` (relative to its size) is refused: such a blade needs a rounded cap, which
-this module does not make.
+within ``tol`` (relative to its size) is refused (:func:`ruled_cap` or
+:func:`rounded_cap` close any end).
+
+The user's choice of ``kind`` in :func:`blade_caps`: "ruled", "planar" or "rounded". The
+rounded form rounds the tip (:func:`rounded_cap`, a dome beyond the last station, tangent
+to the mold halves) and keeps the root planar: the root of a blade is the flat face of its
+root flange (bolted to the pitch bearing), the root circle lies in that plane (the
+structural-zone stations are not wrapped, :func:`~.blade.blade_sections`), and a dome
+there would lie inside the hub. A root that is not planar (a blade without a root
+transition, whose first section is wrapped on its cylinder) gets the ruled cap.
 """
 from __future__ import annotations
 
@@ -147,6 +155,63 @@ def ruled_cap(upper: BSplineSurface, lower: BSplineSurface, v_end: bool, inward)
     return cap
 
 
+#: Length of the rounded tip beyond the last station, as a fraction of the local distance
+#: between the halves' end rows (the thickness): 0.5 gives about a half-round end.
+TIP_BULGE = 0.5
+
+
+def _v_derivative_row(surface: BSplineSurface) -> BSplineCurve:
+    """d/dv of the surface at v = 1 as a curve in u: control points
+    q / (v_last - v_{last-q}) (P_{i,last} - P_{i,last-1}) (NURBS Book Eq. 3.7 in v)."""
+    V, q = surface.knots_v, surface.degree_v
+    P = surface.control_points
+    D = q / (V[-1] - V[-q - 2]) * (P[:, -1] - P[:, -2])
+    return BSplineCurve(surface.degree_u, surface.knots_u, np.array(D))
+
+
+def rounded_cap(upper: BSplineSurface, lower: BSplineSurface, inward, bulge: float = TIP_BULGE) -> BSplineSurface:
+    """A rounded tip: a cubic-in-w surface from the upper half's last row a(u) (TE -> S)
+    to the lower half's last row reversed b(u) (TE -> S), bulging beyond the tip along
+    the halves' own span tangents. Rows (w control points) a_i, a_i + ℓ_i t^a_i,
+    b_i + ℓ_i t^b_i, b_i with t_i the unit v-derivative control vectors of each half at
+    v = 1 and ℓ_i = ``bulge`` × |a_i - b_i| (0 at the TE end, u = 0, so that edge is the
+    trailing-edge base's end segment or the sharp TE point; 0 at S where a = b). Where ℓ
+    is one multiple of the derivative, the cap's w-derivative 3 ℓ t is parallel to the
+    halves' S_v: tangent to them across the tip edge (G1; exactly so for constant ℓ/|D|,
+    nearly so elsewhere). Its w = 0 and w = 1 edges are the halves' rows themselves
+    (after exact knot insertion, NURBS Book §10.3), as for :func:`ruled_cap`. Oriented
+    with S_u × S_w pointing away from ``inward``."""
+    from ..nurbs import make_compatible
+
+    if not (np.isfinite(bulge) and bulge > 0):
+        raise GeometryError(f"the tip bulge must be a positive fraction of the thickness, got {bulge!r}")
+    if upper.weights is not None or lower.weights is not None:
+        raise GeometryError("a rounded cap needs non-rational mold halves")
+    a, da, b, db = make_compatible([_row(upper, True), _v_derivative_row(upper),
+                                    reverse(_row(lower, True)), reverse(_v_derivative_row(lower))])
+    A, B = a.control_points, b.control_points
+    size = float(np.ptp(np.vstack([A, B]), axis=0).max())
+    ell = bulge * np.linalg.norm(A - B, axis=1)
+    ell[0] = 0.0
+    ell[np.linalg.norm(A - B, axis=1) <= CHAIN_TOL * size] = 0.0
+
+    def unit(D):
+        n = np.linalg.norm(D, axis=1, keepdims=True)
+        return np.divide(D, n, out=np.zeros_like(D), where=n > 0)
+
+    net = np.stack([A, A + ell[:, None] * unit(da.control_points), B + ell[:, None] * unit(db.control_points), B],
+                   axis=1)
+    for i in (0, -1):  # a sharp TE (and S): one point, not two 1e-17 m apart
+        if float(np.linalg.norm(net[i, 0] - net[i, 3])) <= CHAIN_TOL * size:
+            net[i, :] = net[i, 0]
+    W = np.array([0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0])
+    cap = BSplineSurface(a.degree, 3, a.knots, W, net)
+    D = cap.derivatives(0.5, 0.5, 1)
+    if float(np.cross(D[1, 0], D[0, 1]) @ np.asarray(inward, dtype=np.float64)) > 0:
+        cap = BSplineSurface(a.degree, 3, a.knots, W, net[:, ::-1])
+    return cap
+
+
 def blade_caps(molds, kind: str = "ruled") -> tuple:
     """(root cap, tip cap) of :class:`~.blade.BladeMolds`: the root over the transitions'
     (or, without them, the halves') v = 0 rows, the tip over the halves' v = 1 rows (with
@@ -154,13 +219,35 @@ def blade_caps(molds, kind: str = "ruled") -> tuple:
     (:func:`ruled_cap`, BSplineSurface, any section) or "planar" (:func:`planar_cap`, a
     :class:`Cap`, only for planar end sections)."""
     s = molds.surfaces
-    root = [s[n] for n in ("transition_upper", "transition_lower", "transition_trailing_edge") if n in s]
-    if not root:
-        root = [s[n] for n in ("upper", "lower", "trailing_edge") if n in s]
-    tip = [s[n] for n in ("upper", "lower", "trailing_edge") if n in s]
+
+    def end(halves, prefix, v_end):
+        """The halves and the trailing-edge bases (``prefix``, ``prefix_2``, ...) that reach
+        this end: a base ends where the trailing edge turns sharp (NREL 5-MW at 44.55 m)."""
+        up, lo = s[halves[0]], s[halves[1]]
+        size = max(up.size(), lo.size())
+        ends = (_row(up, v_end).control_points[0], _row(lo, v_end).control_points[-1])
+        out = [up, lo]
+        for name, surface in s.items():
+            if name == prefix or name.startswith(prefix + "_"):
+                P = _row(surface, v_end).control_points
+                if all(min(np.linalg.norm(P[i] - e) for e in ends) <= CHAIN_TOL * size for i in (0, -1)):
+                    out.append(surface)
+        return out
+
+    if "transition_upper" in s:
+        root = end(("transition_upper", "transition_lower"), "transition_trailing_edge", False)
+    else:
+        root = end(("upper", "lower"), "trailing_edge", False)
+    tip = end(("upper", "lower"), "trailing_edge", True)
     span = tip[0].evaluate(0.5, 1.0) - root[0].evaluate(0.5, 0.0)
     if kind == "planar":
         return planar_cap(root, False, span, "root"), planar_cap(tip, True, -span, "tip")
+    if kind == "rounded":
+        try:
+            root_cap = planar_cap(root, False, span, "root")
+        except GeometryError:
+            root_cap = ruled_cap(root[0], root[1], False, span)
+        return root_cap, rounded_cap(tip[0], tip[1], -span)
     if kind != "ruled":
-        raise GeometryError(f"unknown cap kind {kind!r}; expected 'ruled' or 'planar'")
+        raise GeometryError(f"unknown cap kind {kind!r}; expected 'ruled', 'planar' or 'rounded'")
     return ruled_cap(root[0], root[1], False, span), ruled_cap(tip[0], tip[1], True, -span)
