@@ -38,8 +38,9 @@ BLADES = [pytest.param("s823_small", id="s823_small"),
           pytest.param("nrel5mw", id="nrel5mw", marks=pytest.mark.skipif(not SLOW, reason="slow; BLADESMITH_SLOW=1"))]
 
 
+@pytest.mark.parametrize("caps", ["ruled", "rounded"])
 @pytest.mark.parametrize("name", BLADES)
-def test_closed_blade_sews_into_one_valid_solid(name, tmp_path):
+def test_closed_blade_sews_into_one_valid_solid(name, caps, tmp_path):
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
     from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.BRepGProp import BRepGProp
@@ -48,7 +49,7 @@ def test_closed_blade_sews_into_one_valid_solid(name, tmp_path):
     from OCP.TopoDS import TopoDS
 
     molds = molds_of(name)
-    path = write_closed_blade(tmp_path / f"{name}.igs", molds)
+    path = write_closed_blade(tmp_path / f"{name}.igs", molds, caps=caps)
     occ = read_with_occ(path)
     assert occ.load_messages == [] and occ.transfer_messages == []
     assert len(occ.faces) == len(molds.surfaces) + 2
@@ -88,3 +89,31 @@ def test_cap_edges_are_the_halves_end_rows():
         assert float(normal @ (cap.evaluate(0.5, 0.5) - mid)) > 0
     with pytest.raises(GeometryError, match="not planar"):
         blade_caps(molds, "planar")
+
+
+def test_rounded_tip_is_tangent_to_the_halves_and_beyond_the_tip():
+    """The rounded tip (issue 16, the user's choice of rounded caps): its long edges are the
+    halves' last rows, it lies outside the tip section's cylinder (a dome, not a dent), its
+    normal along those edges is the halves' (G1 within 0.01°), and the root stays planar
+    (the flange face)."""
+    from bladesmith.geometry.mold.caps import Cap
+    from bladesmith.geometry.nurbs.projection import closest_point_curve
+
+    molds = molds_of("s823_small")
+    root, tip = blade_caps(molds, "rounded")
+    assert isinstance(root, Cap)
+    u = np.linspace(0.0, 1.0, 101)
+    r_tip = molds.definition.stations[-1].r
+    chord = molds.definition.stations[-1].chord
+    dome = tip.evaluate(u, np.full_like(u, 0.5))
+    beyond = np.hypot(dome[:, 0], dome[:, 2]) - r_tip
+    assert beyond.min() >= -1e-12 * r_tip and beyond.max() > 0.02 * chord
+    ui = np.linspace(0.05, 0.95, 19)
+    for w, half in ((0.0, molds.upper), (1.0, molds.lower)):
+        edge = tip.evaluate(ui, np.full_like(ui, w))
+        t, d = closest_point_curve(half.iso_curve("v", 1.0), edge)[:2]
+        assert np.max(d) <= 1e-12 * molds.upper.size()
+        n_cap = tip.normal(ui, np.full_like(ui, w))
+        n_half = half.normal(np.asarray(t), np.ones_like(t))
+        angle = np.degrees(np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", n_cap, n_half)), 0.0, 1.0)))
+        assert angle.max() < 0.01, f"tip cap not tangent to the halves: {angle.max():.3g}°"
