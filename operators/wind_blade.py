@@ -297,6 +297,9 @@ def store_results(settings, molds: BladeMolds, seconds: float) -> None:
         smoothed = [st.airfoil.smoothing_deviation for st in defn.stations if st.airfoil.smoothing_deviation is not None]
         note = f"; airfoils smoothed (Hvid), worst deviation {max(smoothed):.2e} chord" if smoothed else ""
         aligned = "; aligned parameters (the chord-length ones missed)" if molds.aligned_parameters else ""
+        if getattr(molds, "densified", False):
+            aligned = ("; densified fit (the data could not carry the control points the tolerance needs: each "
+                       "section's interpolant fitted, deviation at the data points)")
         if settings.fairness_valid:  # both approaches are always built: the numbers in either mode
             shown = "mold halves" if settings.mold_halves else "single surface"
             note += (f"; fairness (Hosseini Eq. 6, shown: {shown}): MVS two-part {settings.mvs_two_part:.4g}, "

@@ -21,7 +21,7 @@ from scipy.interpolate import BSpline
 from scipy.optimize import brentq, minimize
 
 from ..errors import GeometryError
-from ..nurbs import BSplineCurve, fit_least_squares, interpolate, parameterize
+from ..nurbs import BSplineCurve, interpolate, parameterize
 from ..nurbs.fitting import approximation_knots
 
 #: Default degree of the section curves (cubic, as in Hosseini §2).
@@ -231,6 +231,29 @@ def _residual(curve: BSplineCurve, points, params) -> np.ndarray:
     return np.asarray(points) - curve.evaluate(params)
 
 
+def _normal_equations_banded(A, R, degree: int) -> np.ndarray:
+    """Least-squares solution of A X = R for a sparse B-spline collocation matrix A (each
+    row has at most degree + 1 consecutive non-zeros): the normal equations AᵀA X = AᵀR
+    (NURBS Book Eq. 9.66), banded with bandwidth p and symmetric positive definite when
+    every column has data (Schoenberg–Whitney), solved by ``solveh_banded``. A dense
+    ``lstsq`` (an SVD) costs O(m n²) per fit; this is O(m p²)."""
+    from scipy.linalg import LinAlgError, solveh_banded
+
+    M = (A.T @ A).todia()
+    band = np.zeros((degree + 1, A.shape[1]))
+    for off, diag in zip(M.offsets, M.data):
+        if 0 <= off <= degree:
+            band[degree - off, off:] = diag[off:]
+    try:
+        X = solveh_banded(band, A.T @ R, check_finite=False)
+    except LinAlgError:
+        X = None
+    if X is None or not np.all(np.isfinite(X)):
+        raise GeometryError("the least-squares system is rank deficient: some knot span holds no data "
+                            "parameter (Schoenberg–Whitney); use fewer control points or other knots")
+    return X
+
+
 class _AffineHalf:
     """One half fitted with its end derivative λ·t at S: the least-squares control points
     are affine in λ (the prescribed control point P_1 or P_{n-1} of Piegl & Tiller 2000
@@ -257,8 +280,6 @@ class _AffineHalf:
         normal equations of the free control points (banded, bandwidth p, symmetric
         positive definite when every free basis function has data: Schoenberg–Whitney)
         by ``solveh_banded``, both right-hand sides at once."""
-        from scipy.linalg import LinAlgError, solveh_banded
-
         Q, U, p = self.points, self.knots, self.degree
         nc = len(U) - p - 1
         n = nc - 1
@@ -281,22 +302,9 @@ class _AffineHalf:
         free = np.flatnonzero(~fixed)
         if free.size:
             rows = N[1:-1]
-            A = rows[:, free]
             R0 = Q[1:-1] - rows[:, fixed] @ P0[fixed]
             R1 = -(rows[:, fixed] @ dP[fixed])
-            M = (A.T @ A).todia()
-            band = np.zeros((p + 1, free.size))
-            for off, diag in zip(M.offsets, M.data):
-                if 0 <= off <= p:
-                    band[p - off, off:] = diag[off:]
-            rhs = A.T @ np.hstack([R0, R1])
-            try:
-                X = solveh_banded(band, rhs, check_finite=False)
-            except LinAlgError:
-                X = None
-            if X is None or not np.all(np.isfinite(X)):
-                raise GeometryError("the least-squares system is rank deficient: some knot span holds no data "
-                                    "parameter (Schoenberg–Whitney); use fewer control points or other knots")
+            X = _normal_equations_banded(rows[:, free], np.hstack([R0, R1]), p)
             dim = Q.shape[1]
             P0[free], dP[free] = X[:, :dim], X[:, dim:]
         return P0, dP
@@ -443,7 +451,19 @@ def fit_single(points, knots=None, n_control: int = 23, degree: int = SECTION_DE
     K = approximation_knots(t, n_control, degree) if knots is None else np.asarray(knots)
     if align:
         t = aligned_parameters(Q, K, degree)
-    c = fit_least_squares(Q, len(K) - degree - 1, degree, params=t, knots=K)
+    nc = len(K) - degree - 1
+    if nc < degree + 1 or nc > len(Q):
+        raise GeometryError(f"{nc} control points of degree {degree} need between {degree + 1} and {len(Q)} "
+                            f"(the data points)")
+    # the ends interpolated, the rest by least squares (NURBS Book §9.4.1), banded normal equations
+    N = BSpline.design_matrix(t, K, degree).tocsc()
+    P = np.zeros((nc, Q.shape[1]))
+    P[0], P[-1] = Q[0], Q[-1]
+    rows = N[1:-1]
+    if nc > 2:
+        R = Q[1:-1] - rows[:, [0, nc - 1]] @ P[[0, -1]]
+        P[1:-1] = _normal_equations_banded(rows[:, 1:-1], R, degree)
+    c = BSplineCurve(degree, K, P)
     r = _residual(c, Q, t)
     if marks is not None:
         r = r[marks]
