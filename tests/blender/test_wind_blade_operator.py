@@ -311,6 +311,20 @@ def test_export_iges_closed_blade_with_caps(root, tmp_path):
         rec.label not in ("LEPART",) for rec in model.of_type(BSplineCurve126))
 
 
+def test_export_iges_closed_blade_with_rounded_tip(root, tmp_path):
+    """caps='ROUNDED': the root cap a plane trimmed by the end rows (144 over a 128 with
+    the root's loop), the tip a rounded 128, cubic across."""
+    from bladesmith.iges.records import TrimmedSurface
+
+    root.bladesmith_wind_blade.mold_halves = True
+    path = tmp_path / "rounded.igs"
+    assert bpy.ops.bladesmith.export_wind_blade_iges(filepath=str(path), caps="ROUNDED") == {"FINISHED"}
+    model = read_iges(str(path))
+    surfaces = {rec.label: rec for rec in model.of_type(BSplineSurface128)}
+    assert surfaces["TIPCAP"].degree_v == 3
+    assert any(rec.label == "ROOTCAP" for rec in model.of_type(TrimmedSurface))
+
+
 def test_blend_file_keeps_the_definition(root, tmp_path):
     s = root.bladesmith_wind_blade
     s.stations[6].twist_deg = 3.5
