@@ -498,7 +498,8 @@ def _no_fit_message(defn: BladeDefinition, attempts: list, tols: np.ndarray) -> 
         if why:
             msg += f" ({why})"
         fixes = [f"tolerance = {float(np.max(worst)) * 1.01:.2g} (or this station's tolerance {worst[k] * 1.01:.2g}) "
-                 f"with control_points = {n}"]
+                 + ("(the densified fit starts again from the count the plain fit reaches)" if align == "dense"
+                    else f"with control_points = {n}")]
         if k == defn.first_aerodynamic_station and k + 1 < len(defn.stations) - 1:
             fixes.append(f"first_aerodynamic_station = {k + 1} (station {k} in the root transition)")
         return msg + "; nearest setting that builds: " + " or ".join(fixes) + f" (worst/tolerance {reach:.3g})"
@@ -579,10 +580,11 @@ def _fit_dense(defn: BladeDefinition, splits, n: int, tols: np.ndarray, degree: 
             return fits, rho, count
         if count >= MAX_DENSE_CONTROL_POINTS:
             return None
-        knots = _refined_knots(dense, fits, knots, tols, chords, degree)
-        over = max(len(K) - degree - 1 for K in knots) - MAX_DENSE_CONTROL_POINTS
-        if over > 0:
-            return None
+        refined = _refined_knots(dense, fits, knots, tols, chords, degree)
+        grown = max(len(K) - degree - 1 for K in refined)
+        if grown > MAX_DENSE_CONTROL_POINTS or all(len(a) == len(b) for a, b in zip(refined, knots)):
+            return None  # at the limit, or no span to halve (bounded work either way)
+        knots = refined
 
 
 def fit_sections(defn: BladeDefinition, splits, n: int, tols: np.ndarray, degree: int = SECTION_DEGREE,
