@@ -134,14 +134,18 @@ MESH_MIN_SIZE = 0.005
 #: conditioning; the propeller mesh test (test_full_propeller_mesh.py) uses the same bar.
 MIN_SICN = 0.05
 
+#: Blades whose closed solid is valid but whose coarse mesh is known to miss MIN_SICN, with
+#: the cause measured; everything else is still asserted, and the test fails if they pass.
+KNOWN_SLIVERS = {
+    "nrel5mw": "NREL 5-MW's blunt trailing-edge base is 12-32 mm wide on a 61 m blade (its triangles are slivers "
+               "at a coarse 0.3 m+ size) and ends in zero-angle cusps where the trailing edge turns sharp "
+               "(r = 44.55 m) and where it leaves the root circle (r ~ 8 m); measured min SICN 0.0013 at the cusps",
+}
+
 MESH_CASES = [
     pytest.param("s823_small", "ruled", id="s823_small-ruled"),
     pytest.param("s823_small", "rounded", id="s823_small-rounded"),
-    pytest.param("nrel5mw", "rounded", id="nrel5mw-rounded", marks=pytest.mark.xfail(
-        strict=True, reason="NREL 5-MW's blunt trailing-edge base is 12-32 mm wide on a 61 m blade (its "
-        "triangles are slivers at a coarse 0.3 m+ size) and ends in zero-angle cusps where the trailing edge "
-        "turns sharp (r = 44.55 m) and where it leaves the root circle (r ~ 8 m): measured min SICN 0.0013 at "
-        "the cusps, 0.008 along the base (a zero-angle face corner makes a sliver at any mesh size)")),
+    pytest.param("nrel5mw", "rounded", id="nrel5mw-rounded"),
 ]
 
 
@@ -223,4 +227,7 @@ def test_fluid_around_the_closed_blade_volume_meshes(name, caps, tmp_path):
     valid, tets, min_sicn = _fluid_mesh(solid, size * 1000.0)
     print(f"\n{name} ({caps} caps): {tets} tetrahedra, min SICN {min_sicn:.4g}")
     assert valid and tets > 1000
+    if name in KNOWN_SLIVERS:
+        assert min_sicn <= MIN_SICN, f"{name} now meshes (min SICN {min_sicn:.4g}): drop it from KNOWN_SLIVERS"
+        pytest.xfail(f"min SICN {min_sicn:.4g}: {KNOWN_SLIVERS[name]}")
     assert min_sicn > MIN_SICN, f"min SICN {min_sicn:.4g}"
