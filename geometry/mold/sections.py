@@ -198,10 +198,11 @@ def densified(split: SplitSection, samples: int = DENSE_SAMPLES) -> SplitSection
     per station; with coarse or irregular data (windIO airfoils: ~100 points a side, with
     corners and 1e-4-chord zig-zags) that tolerance needs about as many control points as
     there are points, where the least-squares problem (Eq. 3) is ill-posed: knot spans of
-    the common knot vector (§3) hold no data. The interpolant passes through every data
-    point and is the fairest C2 cubic that does (NURBS Book §9.2.1); a least-squares fit of
-    its dense samples is well posed for any count, and its deviation is still measured at
-    the original points only (:func:`~.blade.section_deviation`)."""
+    the common knot vector (§3) hold no data. The interpolant is a C2 cubic through every
+    data point (chord-length parameters, averaged knots: NURBS Book §9.2.1) with no
+    shape of its own between them beyond the data's; a least-squares fit of its dense
+    samples is well posed for any count, and its deviation is still measured at the
+    original points only (:func:`~.blade.section_deviation`)."""
     if split.interpolant is None:
         raise GeometryError("the split has no interpolant to densify")
     t = parameterize(split.points)
