@@ -47,6 +47,29 @@ def test_srv2o_fitted_within_target(fitted):
     assert fitted.count == 13 and fitted.channel.count >= 1
 
 
+def test_srv2o_blade_edges_on_the_fitted_walls(fitted):
+    """The fitted blades' hub and shroud edges lie on the fitted channel walls to 1e-6 of
+    the outer diameter (2 × 112 mm), as the presets' do: measured here independently, at
+    true foot points on the exported walls' contours, 50 samples per patch."""
+    from bladesmith.geometry.compressor.blade import _guess, wall_foot
+
+    diameter = 2 * 0.112
+    assert fitted.wall_tolerance == pytest.approx(1e-6 * diameter, rel=1e-3)
+    worst = 0.0
+    for name, sides in fitted.blades.items():
+        for side, surface in sides.items():
+            for string, wall in ((surface.lower, fitted.channel.hub), (surface.upper, fitted.channel.shroud)):
+                U = np.linspace(0.0, string.count, string.count * 50 + 1)
+                X = string.evaluate(U)
+                zr = np.stack([X[:, 2], np.hypot(X[:, 0], X[:, 1])], axis=-1)
+                Uw, gap = wall_foot(wall, zr, _guess(wall, zr))
+                assert np.all((Uw > 0.0) & (Uw < wall.count)), f"{name} {side}: edge past the end of the wall"
+                worst = max(worst, float(gap.max()))
+    print(f"\nSRV2-O fitted edges: largest distance from the walls {worst * 1e3:.2e} mm "
+          f"({worst / diameter:.2e} D); patches {fitted.patches}")
+    assert worst <= 1e-6 * diameter
+
+
 def test_srv2o_export_read_by_occ_and_meshed(fitted, tmp_path):
     pytest.importorskip("OCP")
     from occ_support import is_valid, read_with_occ
