@@ -15,7 +15,9 @@ to be used ... in approximation of the geometry of existing ones").
   so that the walls hold every blade edge;
 - :func:`edges_on_walls`: the fitted surface rebuilt with its hub and shroud edges on the
   channel walls (Casey 1983: the ruled patches are bounded by curves on the walls; the
-  edges are constructed on the walls and the surface ruled between them).
+  edges are constructed on the walls and the surface ruled between them);
+- :func:`fit_general_surface`: the fallback for a blade the best ruled surface misses, a
+  surface cubic in v whose hub and shroud edges are the ruled surface's.
 """
 from __future__ import annotations
 
@@ -23,8 +25,8 @@ import numpy as np
 from scipy.interpolate import make_interp_spline, make_lsq_spline
 
 from ..errors import GeometryError
-from ..nurbs import BSplineCurve, bezier_segments
-from .bezier import BezierCurve, BezierString, PatchString
+from ..nurbs import BSplineCurve, BSplineSurface, bezier_segments
+from .bezier import BezierCurve, BezierString, PatchString, bernstein
 from .blade import CHECK_SAMPLES, FOOT_ITERATIONS, PATCH_MARGIN, _guess, wall_foot
 from .channel import MeridionalChannel
 
@@ -245,20 +247,33 @@ MAX_EDGE_PATCHES = 512
 
 def _on_wall(surface: PatchString, wall: BezierString, u, v0: float):
     """Points and u-derivatives of the curve in which the ruled ``surface`` meets the wall
-    of revolution: on each ruling L(u, v) = A(u) + v (B(u) - A(u)) the point whose
-    meridional trace (z, r) lies on the wall contour C(U), by Newton on (v, U) from
-    v = ``v0`` (0 near the hub, 1 near the shroud); dv/du and dU/du by differentiating
-    L(u, v)'s trace = C(U). The rulings are kept, so the surface is only trimmed or
-    continued along them. Returns (points, du-derivatives, v)."""
+    of revolution (:func:`_isocurves_on_wall` on its rulings): the rulings are kept, so
+    the surface is only trimmed or continued along them. Returns (points, du-derivatives, v)."""
     A, dA = surface.lower.derivatives(u, 1)
     B, dB = surface.upper.derivatives(u, 1)
-    d = B - A
-    v = np.full(len(A), float(v0))
-    P = A + v[:, None] * d
+    return _isocurves_on_wall(np.stack([A, B], axis=1), np.stack([dA, dB], axis=1), wall, v0)
+
+
+def _isocurves_on_wall(Q, dQ, wall: BezierString, v0: float):
+    """Where the curves C_k(v) = Σ_i B_i(v) Q[k, i] (Bézier in v, extended beyond [0, 1] as
+    polynomials) meet the wall of revolution: the v whose meridional trace (z, r) lies on
+    the wall contour C(U), by Newton on (v, U) from v = ``v0``; and the derivative of that
+    point along u (Q's u-derivatives dQ), from differentiating trace(C(u, v)) = C(U).
+    Returns (points, du-derivatives, v)."""
+    Q, dQ = np.asarray(Q, dtype=float), np.asarray(dQ, dtype=float)
+    degree = Q.shape[1] - 1
+    hodograph = degree * np.diff(Q, axis=1)
+
+    def curve(v):
+        return np.einsum("ki,kid->kd", bernstein(degree, v), Q), np.einsum("ki,kid->kd", bernstein(degree - 1, v),
+                                                                           hodograph)
+
+    v = np.full(len(Q), float(v0))
+    P, _ = curve(v)
     zr = np.stack([P[:, 2], np.hypot(P[:, 0], P[:, 1])], axis=-1)
     U, _ = wall_foot(wall, zr, _guess(wall, zr))
     for _ in range(FOOT_ITERATIONS):
-        P = A + v[:, None] * d
+        P, d = curve(v)
         r = np.hypot(P[:, 0], P[:, 1])
         C, C1 = wall.derivatives(U, 1)
         F = np.stack([P[:, 2] - C[:, 0], r - C[:, 1]], axis=-1)
@@ -270,10 +285,10 @@ def _on_wall(surface: PatchString, wall: BezierString, u, v0: float):
         U = np.clip(U - dU, 0.0, wall.count)
         if max(np.max(np.abs(dv)), np.max(np.abs(dU))) < INTERSECTION_TOLERANCE:
             break
-    P = A + v[:, None] * d
+    P, d = curve(v)
     r = np.hypot(P[:, 0], P[:, 1])
     C1 = wall.derivatives(U, 1)[1]
-    Lu = dA + v[:, None] * (dB - dA)
+    Lu = np.einsum("ki,kid->kd", bernstein(degree, v), dQ)
     a, b = d[:, 2], (P[:, 0] * d[:, 0] + P[:, 1] * d[:, 1]) / r
     gz, gr = Lu[:, 2], (P[:, 0] * Lu[:, 0] + P[:, 1] * Lu[:, 1]) / r
     det = -a * C1[:, 1] + C1[:, 0] * b
@@ -310,21 +325,34 @@ def edges_on_walls(surface: PatchString, channel: MeridionalChannel, wall_tolera
     if breaks.size != n + 1:
         raise GeometryError(f"{breaks.size} junction parameters for a surface of {n} patches")
 
-    def U_of(tau):
+    def isocurves(tau):
         k = np.clip(np.searchsorted(breaks, tau, side="right") - 1, 0, n - 1)
         width = breaks[k + 1] - breaks[k]
-        return k + (tau - breaks[k]) / width, 1.0 / width
+        U = k + (tau - breaks[k]) / width
+        A, dA = surface.lower.derivatives(U, 1)
+        B, dB = surface.upper.derivatives(U, 1)
+        return np.stack([A, B], axis=1), np.stack([dA, dB], axis=1) / width[:, None, None]
 
-    N = n
+    return _edges_from_isocurves(isocurves, breaks, channel, wall_tolerance, max_patches)
+
+
+def _edges_from_isocurves(isocurves, breaks, channel: MeridionalChannel, wall_tolerance: float,
+                          max_patches: int) -> tuple[PatchString, float]:
+    """Hub and shroud edges where the v-curves of a surface meet the walls
+    (:func:`_isocurves_on_wall`), interpolated at common nodes over τ in [0, 1] (the
+    ``breaks`` plus N + 1 equally spaced values, N raised until both edges lie on their
+    walls within ``wall_tolerance``), as the ruled surface between them. ``isocurves(τ)``:
+    the Bézier polygons in v of the v-curves at τ and their τ-derivatives."""
+    N = len(breaks) - 1
     while True:
         grid = np.linspace(0.0, 1.0, N + 1)
         near = np.min(np.abs(grid[:, None] - breaks[None, :]), axis=1) < 0.25 / N
         nodes = np.union1d(grid[~near], breaks)
-        U, rate = U_of(nodes)
+        Q, dQ = isocurves(nodes)
         edges, gap = [], 0.0
         for v0, wall in ((0.0, channel.hub), (1.0, channel.shroud)):
-            W, dW, _ = _on_wall(surface, wall, U, v0)
-            spline = make_interp_spline(nodes, W, k=3, bc_type=([(1, dW[0] * rate[0])], [(1, dW[-1] * rate[-1])]))
+            W, dW, _ = _isocurves_on_wall(Q, dQ, wall, v0)
+            spline = make_interp_spline(nodes, W, k=3, bc_type=([(1, dW[0])], [(1, dW[-1])]))
             edge = BezierString(tuple(BezierCurve(s.control_points)
                                       for s in bezier_segments(BSplineCurve(3, spline.t, spline.c))))
             gap = max(gap, _wall_gap(edge, wall))
@@ -332,3 +360,123 @@ def edges_on_walls(surface: PatchString, channel: MeridionalChannel, wall_tolera
         if gap <= wall_tolerance or N >= max_patches:
             return PatchString(*edges), gap
         N = min(max_patches, max(N + 1, int(np.ceil(N * (gap / wall_tolerance) ** 0.25 * PATCH_MARGIN))))
+
+
+#: General-surface fallback: parameter-correction rounds, and the weight of the smoothing
+#: term (second differences of the correction rows along u, relative to the data term) that
+#: keeps the rows tame where the data leave them free.
+GENERAL_ROUNDS = 3
+GENERAL_FOOT_ITERATIONS = 6
+GENERAL_SMOOTHING = 1e-6
+
+
+def fit_general_surface(surface: PatchString, points, channel: MeridionalChannel, wall_tolerance: float,
+                        max_patches: int = MAX_EDGE_PATCHES) -> tuple[BSplineSurface, float, float]:
+    """A general (non-ruled) B-spline surface through ``points`` (K, 3) for a blade the
+    best ruled surface misses (issue 18: "optionally by a general B-spline surface"),
+    with its hub and shroud edges on the walls.
+
+    ``surface``: the fitted ruled surface (edges on the walls). 1. Raised to degree 3 in v
+    exactly (rows P0, (2P0 + P1)/3, (P0 + 2P1)/3, P1), all four rows are corrected by
+    least squares to the points (:func:`_fit_rows`): a ruled fit's edges are wrong for a
+    non-ruled blade (its rulings extend the data linearly to the walls). 2. The edges are
+    rebuilt where this surface's v-curves meet the walls (:func:`_edges_from_isocurves`).
+    3. Between them the two inner rows are fitted again, the edge rows held, so the edges
+    stay on the walls. Returns (surface, largest distance of the points from it, largest
+    edge-to-wall distance)."""
+    from scipy.interpolate import BSpline
+
+    from .export import ruled_bspline
+
+    first, (u, v) = _fit_rows(ruled_bspline(surface), points, (0, 1, 2, 3))
+    p, t = first.degree_u, first.knots_u
+    a, b = float(t[p]), float(t[-p - 1])
+    rows = BSpline(t, first.control_points.reshape(len(first.control_points), -1), p)
+    slope = rows.derivative()
+
+    def isocurves(tau):
+        u = a + np.asarray(tau) * (b - a)
+        return rows(u).reshape(-1, 4, 3), slope(u).reshape(-1, 4, 3) * (b - a)
+
+    breaks = (np.unique(t[p:len(t) - p]) - a) / (b - a)
+    walls, gap = _edges_from_isocurves(isocurves, breaks, channel, wall_tolerance, max_patches)
+    # the new edges follow τ on [0, 1] as the first surface's u did (linearly, when their
+    # knot spans are the node spacings; Newton corrects the rest)
+    between = ruled_bspline(walls)
+    a2, b2 = between.domain_u
+    final, _ = _fit_rows(between, points, (1, 2), start=(a2 + (u - a) / (b - a) * (b2 - a2), v))
+    from ..nurbs import closest_point_surface
+
+    return final, float(closest_point_surface(final, np.asarray(points, dtype=float))[2].max()), gap
+
+
+def _foot_newton(surface: BSplineSurface, X, u, v, iterations: int = GENERAL_FOOT_ITERATIONS):
+    """Parameter correction: Newton on (S - X)·S_u = (S - X)·S_v = 0 from (u, v) (The
+    NURBS Book 2e Eqs. 6.6–6.8), parameters kept in the domain."""
+    (a, b), (c, d) = surface.domain_u, surface.domain_v
+    for _ in range(iterations):
+        D = surface.derivatives(u, v, 2)
+        r = D[:, 0, 0] - X
+        Su, Sv = D[:, 1, 0], D[:, 0, 1]
+        f, g = np.sum(r * Su, axis=1), np.sum(r * Sv, axis=1)
+        J11 = np.sum(Su * Su, axis=1) + np.sum(r * D[:, 2, 0], axis=1)
+        J12 = np.sum(Su * Sv, axis=1) + np.sum(r * D[:, 1, 1], axis=1)
+        J22 = np.sum(Sv * Sv, axis=1) + np.sum(r * D[:, 0, 2], axis=1)
+        det = J11 * J22 - J12 * J12
+        ok = np.abs(det) > 0.0
+        du = np.where(ok, (J22 * f - J12 * g) / np.where(ok, det, 1.0), 0.0)
+        dv = np.where(ok, (J11 * g - J12 * f) / np.where(ok, det, 1.0), 0.0)
+        u = np.clip(u - du, a, b)
+        v = np.clip(v - dv, c, d)
+    return u, v
+
+
+def _fit_rows(ruled: BSplineSurface, points, free: tuple, rounds: int = GENERAL_ROUNDS, start=None):
+    """``ruled`` (degree (p, 1), non-rational) raised to degree 3 in v, its control rows
+    ``free`` corrected by linear least squares to the points' residuals at their foot
+    parameters (closest points first, or ``start``; then Newton parameter correction on
+    each new surface, The NURBS Book 2e §9.4.1 and §6.1) with a small smoothing term on
+    the rows' second differences along u. Returns (surface, (u, v))."""
+    from scipy.interpolate import BSpline
+    from scipy.sparse import diags, hstack
+    from scipy.sparse.linalg import spsolve
+
+    from ..nurbs import closest_point_surface
+
+    if ruled.degree_v != 1 or ruled.weights is not None:
+        raise GeometryError("the general-surface fallback starts from a non-rational ruled surface (degree 1 in v)")
+    X = np.asarray(points, dtype=float)
+    P0, P1 = ruled.control_points[:, 0], ruled.control_points[:, 1]
+    base = np.stack([P0, (2.0 * P0 + P1) / 3.0, (P0 + 2.0 * P1) / 3.0, P1], axis=1)
+    knots_v = np.array([0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0])
+    p, t = ruled.degree_u, ruled.knots_u
+    nu, m = base.shape[0], len(free)
+    D = diags([np.ones(nu - 2), -2.0 * np.ones(nu - 2), np.ones(nu - 2)], [0, 1, 2], shape=(nu - 2, nu))
+    smooth = _block_diagonal(D, m)
+    surface = BSplineSurface(p, 3, t, knots_v, base)
+    if start is None:
+        u, v, _ = closest_point_surface(surface, X)
+    else:
+        u, v = _foot_newton(surface, X, *start)
+    cp = base
+    for _ in range(rounds):
+        N = BSpline.design_matrix(np.clip(u, t[p], t[-p - 1]), t, p)
+        Bv = bernstein(3, np.clip(v, 0.0, 1.0))
+        A = hstack([diags(Bv[:, i]) @ N for i in free])
+        residual = X - BSplineSurface(p, 3, t, knots_v, base).evaluate(u, v)
+        # normal equations of the data and smoothing terms: sparse and banded in u
+        A = A.tocsr()
+        normal = (A.T @ A + (GENERAL_SMOOTHING * A.shape[0] / nu) * (smooth.T @ smooth)).tocsc()
+        c = spsolve(normal, np.asarray(A.T @ residual))
+        cp = base.copy()
+        for k, row in enumerate(free):
+            cp[:, row] += c[k * nu:(k + 1) * nu]
+        surface = BSplineSurface(p, 3, t, knots_v, cp)
+        u, v = _foot_newton(surface, X, u, v)
+    return surface, (u, v)
+
+
+def _block_diagonal(D, count: int):
+    from scipy.sparse import block_diag
+
+    return block_diag([D] * count).tocsr()

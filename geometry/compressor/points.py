@@ -70,8 +70,8 @@ from ..errors import DefinitionError, GeometryError
 from ..nurbs import closest_point_curve, closest_point_surface
 from .channel import MeridionalChannel
 from .blade import WALL_TOLERANCE
-from .fitting import (EXTENSION_MARGIN, edges_on_walls, extend_channel, fit_channel, fit_ruled_surface,
-                      trim_lines_to_channel)
+from .fitting import (EXTENSION_MARGIN, edges_on_walls, extend_channel, fit_channel, fit_general_surface,
+                      fit_ruled_surface, trim_lines_to_channel)
 
 UNITS = {"m": 1.0, "mm": 1e-3}
 #: Default fit tolerance as a fraction of the largest radius of the data.
@@ -123,6 +123,8 @@ class FittedImpeller:
     wall_tolerance: float = 0.0
     patches: dict = field(default_factory=dict)  # {"<blade> S|P": cubic-linear patches}
     extended: bool = False  # the walls' end patches were continued to hold the blades
+    general: dict = field(default_factory=dict)  # {"<blade> S|P": BSplineSurface} where the ruled fit missed
+    ruled_deviation: dict = field(default_factory=dict)  # {"<blade> S|P": the ruled fit's deviation} for those
 
     @property
     def met(self) -> bool:
@@ -139,6 +141,9 @@ class FittedImpeller:
             text += (f"; edges on the walls within {max(self.wall_gap.values()) * 1e3:.2g} mm "
                      f"(tolerance {self.wall_tolerance * 1e3:.2g} mm); patches "
                      + ", ".join(f"{k} {v}" for k, v in self.patches.items()))
+        if self.general:
+            text += "; general B-spline surfaces for " + ", ".join(
+                f"{k} (ruled fit {self.ruled_deviation[k] * 1e3:.4f} mm)" for k in self.general)
         return text
 
 
@@ -346,7 +351,7 @@ def _split_loop(loop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fit_impeller(points: PointFile, tolerance: float | None = None,
-                 wall_tolerance: float | None = None) -> FittedImpeller:
+                 wall_tolerance: float | None = None, general: bool = False) -> FittedImpeller:
     """Fit the channel and every blade side of ``points`` to ``tolerance`` (metres; default
     DEFAULT_TOLERANCE_FRACTION of the largest data radius) and measure each surface's
     largest distance from its points (true closest points, The NURBS Book 2e §6.1).
@@ -354,7 +359,11 @@ def fit_impeller(points: PointFile, tolerance: float | None = None,
     The blade edges are put on the channel walls (:func:`.fitting.edges_on_walls`) within
     ``wall_tolerance`` (default WALL_TOLERANCE × the outer diameter, 2 × the largest data
     radius, as for the presets); where the data lines reach past the contour data, the
-    walls' end patches are continued to hold them (:func:`.fitting.extend_channel`)."""
+    walls' end patches are continued to hold them (:func:`.fitting.extend_channel`).
+
+    general: a side whose best ruled surface misses its points by more than the
+    tolerance is fitted again by a general B-spline surface (cubic in v, the same edges on
+    the walls; :func:`.fitting.fit_general_surface`); both deviations are reported."""
     hub, shroud = points.walls["hub"], points.walls["shroud"]
     size = float(max(hub[:, 1].max(), shroud[:, 1].max()))
     tol = DEFAULT_TOLERANCE_FRACTION * size if tolerance is None else float(tolerance)
@@ -388,7 +397,7 @@ def fit_impeller(points: PointFile, tolerance: float | None = None,
     extended = bool(np.any(reach[:, 0] < 0.0) or np.any(reach[:, 1] > channel.count))
     if extended:
         channel = extend_channel(channel, reach[0], reach[1])
-    blades, gaps, patches = {}, {}, {}
+    blades, gaps, patches, general_surfaces, ruled_deviation = {}, {}, {}, {}, {}
     for (name, side), (surface, knots, measured) in ruled.items():
         surface, gap = edges_on_walls(surface, channel, wall_tol, knots)
         _, _, dist = closest_point_surface(surface.to_bspline(), measured)
@@ -397,8 +406,11 @@ def fit_impeller(points: PointFile, tolerance: float | None = None,
         deviation[key] = float(dist.max())
         gaps[key] = gap
         patches[key] = surface.count
+        if general and deviation[key] > tol:
+            general_surfaces[key], g, gaps[key] = fit_general_surface(surface, measured, channel, wall_tol)
+            ruled_deviation[key], deviation[key] = deviation[key], g
     return FittedImpeller(points.name, channel, blades, points.count, deviation, tol, gaps, wall_tol, patches,
-                          extended)
+                          extended, general_surfaces, ruled_deviation)
 
 
 def fitted_surfaces(fitted: FittedImpeller, blades: int | None = None) -> list:
@@ -411,7 +423,8 @@ def fitted_surfaces(fitted: FittedImpeller, blades: int | None = None) -> list:
         for i, s in enumerate(channel_wall_quarters(fitted.channel.wall(wall))):
             out.append((f"{wall} {i + 1}", s))
     count = fitted.count if blades is None else int(blades)
-    ref = {name: {side: ruled_bspline(ps) for side, ps in sides.items()} for name, sides in fitted.blades.items()}
+    ref = {name: {side: fitted.general.get(f"{name} {side}") or ruled_bspline(ps) for side, ps in sides.items()}
+           for name, sides in fitted.blades.items()}
     from ..nurbs import BSplineSurface
     for k in range(count):
         a = 2.0 * math.pi * k / fitted.count
