@@ -173,7 +173,9 @@ class WallCamber:
     def _nodes(self, U):
         """(table interval k, half-width, Gauss nodes of [edge_k, U]) for U."""
         U = np.asarray(U, dtype=float)
-        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 2)
+        # beyond the TE (rounded caps) integrate from the last edge itself: the interval
+        # before it may end at a channel junction, where |M'(U)| jumps
+        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 1)
         a = self._edges[k]
         half = 0.5 * (U - a)
         return k, half, a[..., None] + half[..., None] * (_GL_X + 1.0)
@@ -185,7 +187,9 @@ class WallCamber:
     def _partial(self, U, integrand) -> tuple[np.ndarray, np.ndarray]:
         """(k, ∫_{edge_k}^{U} integrand dU) for the table interval k holding U."""
         U = np.asarray(U, dtype=float)
-        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 2)
+        # beyond the TE (rounded caps) integrate from the last edge itself: the interval
+        # before it may end at a channel junction, where |M'(U)| jumps
+        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 1)
         a = self._edges[k]
         half = 0.5 * (U - a)
         nodes = a[..., None] + half[..., None] * (_GL_X + 1.0)
