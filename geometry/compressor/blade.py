@@ -277,9 +277,11 @@ class WallBlade:
         return float(m[0]), float(m[1])
 
 
-def _surface_phi(wb: WallBlade, U, side: float):
+def _surface_phi(wb: WallBlade, U, side):
     """Target of surface ``side`` (0 B, +1 P, -1 S) on its wall at channel parameter U
-    (Casey 1983 steps c and d): z, r, φ, dφ/dm and the wall direction (sin ε, cos ε)."""
+    (Casey 1983 steps c and d): z, r, φ, dφ/dm and the wall direction (sin ε, cos ε).
+    ``side`` may be an array broadcasting against U (several surfaces at once: the wall
+    quantities are computed once); φ and dφ/dm then have the broadcast shape."""
     c = wb.camber
     U = np.asarray(U, dtype=float)
     zr, dzr = c.wall.derivatives(U, 1)
@@ -302,10 +304,13 @@ def _surface_phi(wb: WallBlade, U, side: float):
     return z, r, phi, dphi, sin_e, cos_e
 
 
-def _surface_state(wb: WallBlade, U, side: float):
+def _surface_state(wb: WallBlade, U, side):
     """Points X (k, 3) and dX/dm (k, 3) of surface ``side`` (0 B, +1 P, -1 S) at U, and
-    the angle of dX/dm from the meridional direction (rad)."""
+    the angle of dX/dm from the meridional direction (rad); ``side`` may be an array
+    broadcasting against U (leading axes of the results)."""
     z, r, phi, dphi, sin_e, cos_e = _surface_phi(wb, U, side)
+    shape = np.shape(phi)
+    z, cos_e = np.broadcast_to(z, shape), np.broadcast_to(cos_e, shape)
     X = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
     dX = np.stack(
         [sin_e * np.cos(phi) - r * np.sin(phi) * dphi, sin_e * np.sin(phi) + r * np.cos(phi) * dphi, cos_e], axis=-1
@@ -477,6 +482,29 @@ def edge_deviation(wb: WallBlade, string: BezierString, U_corners, side: float |
     return float(gap.max()), float(np.max(r * np.abs(dphi)))
 
 
+def _edge_deviations(wb: WallBlade, strings, U_corners, sides) -> list[tuple[float, float]]:
+    """:func:`edge_deviation` of several strings of the same patch count on one wall, with
+    one foot-point solve and one target evaluation for all (``sides``: one per string, or
+    None for the wall distance only)."""
+    t = _samples(strings[0].count)
+    X = np.concatenate([string.evaluate(t) for string in strings])
+    zr = _meridional(X)
+    wall = wb.camber.wall
+    if U_corners is not None and np.all(np.isfinite(U_corners)):
+        guess = np.tile(np.interp(t, np.arange(len(U_corners)), U_corners), len(strings))
+    else:
+        guess = _guess(wall, zr)
+    U, gap = wall_foot(wall, zr, guess)
+    gaps = gap.reshape(len(strings), -1).max(axis=1)
+    if sides is None:
+        return [(float(g), 0.0) for g in gaps]
+    U = np.clip(U, wb.U0, wb.U1)
+    _, r, phi, *_ = _surface_phi(wb, U, np.repeat(np.asarray(sides, dtype=float), t.size))
+    dphi = np.angle(np.exp(1j * (np.arctan2(X[:, 1], X[:, 0]) - phi)))
+    errors = (r * np.abs(dphi)).reshape(len(strings), -1).max(axis=1)
+    return [(float(g), float(e)) for g, e in zip(gaps, errors)]
+
+
 def _wall_strings(channel, hub: WallBlade, shroud: WallBlade, n: int, axial: bool, spacing: str):
     """Steps e–f for ``n`` patches: the hub and shroud strings of B, S and P, the imposed
     end angles and the corner parameters."""
@@ -486,15 +514,14 @@ def _wall_strings(channel, hub: WallBlade, shroud: WallBlade, n: int, axial: boo
     if not axial:
         U_shroud = corner_parameters(shroud, n, spacing)
         walls.append((shroud, U_shroud, "upper"))
-    strings, imposed = {}, {}
-    for name, side in (("B", 0.0), ("S", -1.0), ("P", 1.0)):
-        angles = np.zeros((2, 2))
-        for w, (wb, U, which) in enumerate(walls):
-            X, dX, ang = _surface_state(wb, U, side)
-            angles[w] = ang[[0, -1]]
-            v0, v1 = _end_speed(wb, U, spacing)
-            strings[(name, which)] = cubic_string_through(X, dX[0] * v0, dX[-1] * v1)
-        imposed[name] = angles
+    strings, imposed = {}, {name: np.zeros((2, 2)) for name in ("B", "S", "P")}
+    for w, (wb, U, which) in enumerate(walls):
+        # the three surfaces at once: the camber line and thickness at U are shared
+        X, dX, ang = _surface_state(wb, U, np.array([0.0, -1.0, 1.0])[:, None])
+        v0, v1 = _end_speed(wb, U, spacing)
+        for i, name in enumerate(("B", "S", "P")):
+            imposed[name][w] = ang[i, [0, -1]]
+            strings[(name, which)] = cubic_string_through(X[i], dX[i, 0] * v0, dX[i, -1] * v1)
     if axial:
         for name in ("B", "S", "P"):
             strings[(name, "upper")] = _axial_shroud(channel, strings[(name, "lower")], shroud, U_hub)
@@ -506,16 +533,12 @@ def _wall_strings(channel, hub: WallBlade, shroud: WallBlade, n: int, axial: boo
 def _deviations(hub: WallBlade, shroud: WallBlade, surfaces: dict, U_hub, U_shroud, axial: bool) -> dict:
     """Largest wall distance of the hub and shroud edges of B, S and P, camber error (B)
     and offset error of S and P (steps c and d), in metres."""
-    gap = camber = offset = 0.0
-    for name, side in (("B", 0.0), ("S", -1.0), ("P", 1.0)):
-        for wb, string, U, s in ((hub, surfaces[name].lower, U_hub, side),
-                                 (shroud, surfaces[name].upper, U_shroud, None if axial else side)):
-            g, e = edge_deviation(wb, string, U, s)
-            gap = max(gap, g)
-            if name == "B":
-                camber = max(camber, e)
-            else:
-                offset = max(offset, e)
+    names, sides = ("B", "S", "P"), (0.0, -1.0, 1.0)
+    measured = _edge_deviations(hub, [surfaces[k].lower for k in names], U_hub, sides)
+    measured += _edge_deviations(shroud, [surfaces[k].upper for k in names], U_shroud, None if axial else sides)
+    gap = max(g for g, _ in measured)
+    camber = max(e for (g, e), name in zip(measured, names * 2) if name == "B")
+    offset = max(e for (g, e), name in zip(measured, names * 2) if name != "B")
     return {"wall_gap": gap, "camber": camber, "thickness": offset}
 
 
