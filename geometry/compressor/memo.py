@@ -8,7 +8,10 @@ tables), so a hit means "built from the same numbers"; the one exception, the
 standardisation, is keyed by the ids of the blades and the channel it trims with, which
 its kept value holds alive (so the ids cannot be reused while the key exists). The pieces
 kept are immutable model objects, shared by every model built from them. Failures are not
-kept: a refused value is refused again.
+kept: a refused value is refused again. The keys hold the definition's values only, not
+module constants: code (a test) that changes a constant of :mod:`.blade` or
+:mod:`.channel` and rebuilds must call ``MEMORY.clear()`` (or build a definition with
+``memoise=False``).
 """
 from __future__ import annotations
 
