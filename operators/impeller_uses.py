@@ -276,6 +276,10 @@ class BLADESMITH_OT_fit_impeller(bpy.types.Operator):
     tolerance: FloatProperty(name="Tolerance", default=0.0, min=0.0, precision=6, unit="LENGTH",
                              description="Fit tolerance in metres (0: 5e-5 of the largest radius)")
     full_wheel: BoolProperty(name="Full Wheel", default=True)
+    general_surfaces: BoolProperty(
+        name="General Surfaces", default=False,
+        description="Where the best ruled surface misses the points by more than the tolerance, fit a general "
+                    "B-spline surface (edges still on the walls; no longer flank-millable)")
 
     @classmethod
     def poll(cls, context):
@@ -287,7 +291,8 @@ class BLADESMITH_OT_fit_impeller(bpy.types.Operator):
         from .impeller import SURFACE_RESOLUTION
 
         try:
-            fitted = fit_impeller(PointFile(bpy.path.abspath(self.filepath)), self.tolerance or None)
+            fitted = fit_impeller(PointFile(bpy.path.abspath(self.filepath)), self.tolerance or None,
+                                  general=self.general_surfaces)
             surfaces = fitted_surfaces(fitted, None if self.full_wheel else 1)
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))

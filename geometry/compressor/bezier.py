@@ -34,9 +34,27 @@ def bernstein(degree: int, u) -> np.ndarray:
     n = int(degree)
     if n < 0:
         raise GeometryError(f"degree must be >= 0, got {degree}")
-    u = np.asarray(u, dtype=float)[..., None]
+    u = np.asarray(u, dtype=float)
     k, binom = _binomials(n)
-    return binom * u**k * (1.0 - u) ** (n - k)
+    if u.size < BERNSTEIN_POWER_SIZE:
+        u = u[..., None]
+        return binom * u**k * (1.0 - u) ** (n - k)
+    # many parameters: powers by repeated products (float powers cost more than products)
+    out = np.empty(u.shape + (n + 1,))
+    out[..., 0] = 1.0
+    for i in range(1, n + 1):
+        np.multiply(out[..., i - 1], u, out=out[..., i])
+    w = 1.0 - u
+    t = np.ones_like(u)
+    for i in range(n - 1, -1, -1):
+        t *= w
+        out[..., i] *= t
+    out *= binom
+    return out
+
+
+#: Below this many parameters :func:`bernstein` uses powers (fewer numpy calls).
+BERNSTEIN_POWER_SIZE = 256
 
 
 @lru_cache(maxsize=64)
@@ -287,6 +305,8 @@ class BezierString:
         return out
 
     def elevated_to(self, degree: int) -> "BezierString":
+        if all(s.degree == degree for s in self.segments):
+            return self  # immutable: nothing to elevate
         segs = []
         for s in self.segments:
             if s.degree > degree:

@@ -56,6 +56,22 @@ MAX_BETA_DEG = 85.0
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(QUADRATURE_POINTS)
 
 
+def _integration_matrix(x: np.ndarray) -> np.ndarray:
+    """Q with Q[i, j] = ∫_{-1}^{x_i} L_j(t) dt, L_j the Lagrange polynomials on the nodes x:
+    Q @ f gives the running integral of the polynomial through the samples f at each node
+    (spectral integration; exact for degree len(x) - 1)."""
+    k = np.arange(len(x))
+    coefficients = np.linalg.solve(np.vander(x, len(x), increasing=True), np.eye(len(x)))  # column j: L_j
+    antiderivative = coefficients / (k + 1.0)[:, None]
+    powers = lambda t: np.asarray(t, float)[:, None] ** (k + 1.0)[None, :]  # noqa: E731
+    return powers(x) @ antiderivative - powers(np.array([-1.0])) @ antiderivative
+
+
+#: Running integrals to the Gauss nodes of one interval: m at the nodes from the speeds
+#: there, without a second quadrature per node (the integrands of φ and s need β(m)).
+_GL_Q = _integration_matrix(_GL_X)
+
+
 # -- Appendix: C2 cubic strings with prescribed end slopes -------------------------------------
 def cubic_string_through(points, start_derivative, end_derivative) -> BezierString:
     """The C2 cubic Bézier string through ``points`` (n+1, dim), each patch over a unit
@@ -133,15 +149,36 @@ class WallCamber:
         self._edges = edges
         h = np.diff(edges)
         nodes = edges[:-1, None] + 0.5 * h[:, None] * (_GL_X[None, :] + 1.0)
-        speed = self._speed(nodes)
+        r, speed = self._radius_speed(nodes)
         self._m_table = np.r_[0.0, np.cumsum(0.5 * h * (speed @ _GL_W))]
         self.m_total = float(self._m_table[-1])
         if self.m_total <= 0.0:
             raise GeometryError("the blade has zero meridional length")
-        rate = self._phi_rate(nodes.ravel()).reshape(nodes.shape)
+        beta = self._beta_at_nodes(self._m_table[:-1], 0.5 * h, speed)
+        rate = np.tan(beta) / r * speed
         self._phi_table = self.phi0 + np.r_[0.0, np.cumsum(0.5 * h * (rate @ _GL_W))]
-        rate = self._length_rate(nodes.ravel()).reshape(nodes.shape)
+        rate = speed / np.cos(beta)
         self._s_table = np.r_[0.0, np.cumsum(0.5 * h * (rate @ _GL_W))]
+
+    def _radius_speed(self, U) -> tuple[np.ndarray, np.ndarray]:
+        C = self.wall.derivatives(U, 1)
+        return C[0][..., 1], np.linalg.norm(C[1], axis=-1)
+
+    def _beta_at_nodes(self, m_start, half, speed) -> np.ndarray:
+        """β at the Gauss nodes of intervals starting at m = ``m_start`` with half-widths
+        ``half``: m at the nodes by the running integral of the speeds there (_GL_Q)."""
+        m = np.asarray(m_start)[..., None] + np.asarray(half)[..., None] * (speed @ _GL_Q.T)
+        return bernstein_function(self.beta_coefficients, m / self.m_total)
+
+    def _nodes(self, U):
+        """(table interval k, half-width, Gauss nodes of [edge_k, U]) for U."""
+        U = np.asarray(U, dtype=float)
+        # beyond the TE (rounded caps) integrate from the last edge itself: the interval
+        # before it may end at a channel junction, where |M'(U)| jumps
+        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 1)
+        a = self._edges[k]
+        half = 0.5 * (U - a)
+        return k, half, a[..., None] + half[..., None] * (_GL_X + 1.0)
 
     def _speed(self, U) -> np.ndarray:
         d = self.wall.derivatives(U, 1)[1]
@@ -150,7 +187,9 @@ class WallCamber:
     def _partial(self, U, integrand) -> tuple[np.ndarray, np.ndarray]:
         """(k, ∫_{edge_k}^{U} integrand dU) for the table interval k holding U."""
         U = np.asarray(U, dtype=float)
-        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 2)
+        # beyond the TE (rounded caps) integrate from the last edge itself: the interval
+        # before it may end at a channel junction, where |M'(U)| jumps
+        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 1)
         a = self._edges[k]
         half = 0.5 * (U - a)
         nodes = a[..., None] + half[..., None] * (_GL_X + 1.0)
@@ -179,8 +218,10 @@ class WallCamber:
 
     def phi(self, U) -> np.ndarray:
         """φ of the camber line at U: φ_LE + ∫ tan β / r dm (step c)."""
-        k, part = self._partial(U, self._phi_rate)
-        return self._phi_table[k] + part
+        k, half, nodes = self._nodes(U)
+        r, speed = self._radius_speed(nodes)
+        beta = self._beta_at_nodes(self._m_table[k], half, speed)
+        return self._phi_table[k] + half * ((np.tan(beta) / r * speed) @ _GL_W)
 
     def _length_rate(self, U) -> np.ndarray:
         return self._speed(U) / np.cos(self.beta(U))
@@ -188,8 +229,10 @@ class WallCamber:
     def s(self, U) -> np.ndarray:
         """Length along the camber line on this wall from the LE, ds = dm / cos β (the
         blade-surface measure of Casey 1983 step e)."""
-        k, part = self._partial(U, self._length_rate)
-        return self._s_table[k] + part
+        k, half, nodes = self._nodes(U)
+        _, speed = self._radius_speed(nodes)
+        beta = self._beta_at_nodes(self._m_table[k], half, speed)
+        return self._s_table[k] + half * ((speed / np.cos(beta)) @ _GL_W)
 
     def _invert(self, values, measure, rate, table, clip: bool = True) -> np.ndarray:
         values = np.asarray(values, dtype=float)
@@ -230,23 +273,27 @@ class WallBlade:
     phi_offset: float = 0.0
 
     def m_range(self) -> tuple[float, float]:
-        return float(self.camber.m(self.U0)), float(self.camber.m(self.U1))
+        m = self.camber.m(np.array([self.U0, self.U1]))
+        return float(m[0]), float(m[1])
 
 
-def _surface_phi(wb: WallBlade, U, side: float):
+def _surface_phi(wb: WallBlade, U, side):
     """Target of surface ``side`` (0 B, +1 P, -1 S) on its wall at channel parameter U
-    (Casey 1983 steps c and d): z, r, φ, dφ/dm and the wall direction (sin ε, cos ε)."""
+    (Casey 1983 steps c and d): z, r, φ, dφ/dm and the wall direction (sin ε, cos ε).
+    ``side`` may be an array broadcasting against U (several surfaces at once: the wall
+    quantities are computed once); φ and dφ/dm then have the broadcast shape."""
     c = wb.camber
     U = np.asarray(U, dtype=float)
     zr, dzr = c.wall.derivatives(U, 1)
     z, r = zr[..., 0], zr[..., 1]
     g = np.linalg.norm(dzr, axis=-1)
     cos_e, sin_e = dzr[..., 0] / g, dzr[..., 1] / g
-    beta = c.beta(U)
-    dbeta = c.beta_slope(U)
+    mU = c.m(U)
+    beta = bernstein_function(c.beta_coefficients, mU / c.m_total)
+    dbeta = bernstein_function_derivative(c.beta_coefficients, mU / c.m_total) / c.m_total
     m0, m1 = wb.m_range()
     length = m1 - m0
-    mbar = (c.m(U) - m0) / length
+    mbar = (mU - m0) / length
     delta = bernstein_function(wb.thickness, mbar)
     ddelta = bernstein_function_derivative(wb.thickness, mbar) / length
     cb = np.cos(beta)
@@ -257,10 +304,13 @@ def _surface_phi(wb: WallBlade, U, side: float):
     return z, r, phi, dphi, sin_e, cos_e
 
 
-def _surface_state(wb: WallBlade, U, side: float):
+def _surface_state(wb: WallBlade, U, side):
     """Points X (k, 3) and dX/dm (k, 3) of surface ``side`` (0 B, +1 P, -1 S) at U, and
-    the angle of dX/dm from the meridional direction (rad)."""
+    the angle of dX/dm from the meridional direction (rad); ``side`` may be an array
+    broadcasting against U (leading axes of the results)."""
     z, r, phi, dphi, sin_e, cos_e = _surface_phi(wb, U, side)
+    shape = np.shape(phi)
+    z, cos_e = np.broadcast_to(z, shape), np.broadcast_to(cos_e, shape)
     X = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
     dX = np.stack(
         [sin_e * np.cos(phi) - r * np.sin(phi) * dphi, sin_e * np.sin(phi) + r * np.cos(phi) * dphi, cos_e], axis=-1
@@ -432,6 +482,29 @@ def edge_deviation(wb: WallBlade, string: BezierString, U_corners, side: float |
     return float(gap.max()), float(np.max(r * np.abs(dphi)))
 
 
+def _edge_deviations(wb: WallBlade, strings, U_corners, sides) -> list[tuple[float, float]]:
+    """:func:`edge_deviation` of several strings of the same patch count on one wall, with
+    one foot-point solve and one target evaluation for all (``sides``: one per string, or
+    None for the wall distance only)."""
+    t = _samples(strings[0].count)
+    X = np.concatenate([string.evaluate(t) for string in strings])
+    zr = _meridional(X)
+    wall = wb.camber.wall
+    if U_corners is not None and np.all(np.isfinite(U_corners)):
+        guess = np.tile(np.interp(t, np.arange(len(U_corners)), U_corners), len(strings))
+    else:
+        guess = _guess(wall, zr)
+    U, gap = wall_foot(wall, zr, guess)
+    gaps = gap.reshape(len(strings), -1).max(axis=1)
+    if sides is None:
+        return [(float(g), 0.0) for g in gaps]
+    U = np.clip(U, wb.U0, wb.U1)
+    _, r, phi, *_ = _surface_phi(wb, U, np.repeat(np.asarray(sides, dtype=float), t.size))
+    dphi = np.angle(np.exp(1j * (np.arctan2(X[:, 1], X[:, 0]) - phi)))
+    errors = (r * np.abs(dphi)).reshape(len(strings), -1).max(axis=1)
+    return [(float(g), float(e)) for g, e in zip(gaps, errors)]
+
+
 def _wall_strings(channel, hub: WallBlade, shroud: WallBlade, n: int, axial: bool, spacing: str):
     """Steps e–f for ``n`` patches: the hub and shroud strings of B, S and P, the imposed
     end angles and the corner parameters."""
@@ -441,15 +514,14 @@ def _wall_strings(channel, hub: WallBlade, shroud: WallBlade, n: int, axial: boo
     if not axial:
         U_shroud = corner_parameters(shroud, n, spacing)
         walls.append((shroud, U_shroud, "upper"))
-    strings, imposed = {}, {}
-    for name, side in (("B", 0.0), ("S", -1.0), ("P", 1.0)):
-        angles = np.zeros((2, 2))
-        for w, (wb, U, which) in enumerate(walls):
-            X, dX, ang = _surface_state(wb, U, side)
-            angles[w] = ang[[0, -1]]
-            v0, v1 = _end_speed(wb, U, spacing)
-            strings[(name, which)] = cubic_string_through(X, dX[0] * v0, dX[-1] * v1)
-        imposed[name] = angles
+    strings, imposed = {}, {name: np.zeros((2, 2)) for name in ("B", "S", "P")}
+    for w, (wb, U, which) in enumerate(walls):
+        # the three surfaces at once: the camber line and thickness at U are shared
+        X, dX, ang = _surface_state(wb, U, np.array([0.0, -1.0, 1.0])[:, None])
+        v0, v1 = _end_speed(wb, U, spacing)
+        for i, name in enumerate(("B", "S", "P")):
+            imposed[name][w] = ang[i, [0, -1]]
+            strings[(name, which)] = cubic_string_through(X[i], dX[i, 0] * v0, dX[i, -1] * v1)
     if axial:
         for name in ("B", "S", "P"):
             strings[(name, "upper")] = _axial_shroud(channel, strings[(name, "lower")], shroud, U_hub)
@@ -461,16 +533,12 @@ def _wall_strings(channel, hub: WallBlade, shroud: WallBlade, n: int, axial: boo
 def _deviations(hub: WallBlade, shroud: WallBlade, surfaces: dict, U_hub, U_shroud, axial: bool) -> dict:
     """Largest wall distance of the hub and shroud edges of B, S and P, camber error (B)
     and offset error of S and P (steps c and d), in metres."""
-    gap = camber = offset = 0.0
-    for name, side in (("B", 0.0), ("S", -1.0), ("P", 1.0)):
-        for wb, string, U, s in ((hub, surfaces[name].lower, U_hub, side),
-                                 (shroud, surfaces[name].upper, U_shroud, None if axial else side)):
-            g, e = edge_deviation(wb, string, U, s)
-            gap = max(gap, g)
-            if name == "B":
-                camber = max(camber, e)
-            else:
-                offset = max(offset, e)
+    names, sides = ("B", "S", "P"), (0.0, -1.0, 1.0)
+    measured = _edge_deviations(hub, [surfaces[k].lower for k in names], U_hub, sides)
+    measured += _edge_deviations(shroud, [surfaces[k].upper for k in names], U_shroud, None if axial else sides)
+    gap = max(g for g, _ in measured)
+    camber = max(e for (g, e), name in zip(measured, names * 2) if name == "B")
+    offset = max(e for (g, e), name in zip(measured, names * 2) if name != "B")
     return {"wall_gap": gap, "camber": camber, "thickness": offset}
 
 
@@ -624,6 +692,57 @@ def junction_kinks(blade: BladeSurfaces, samples: int = 11) -> dict:
     return out
 
 
+@dataclass(frozen=True, eq=False)
+class BladeStrings:
+    """Steps e–f of one blade at its chosen patch count (:func:`blade_strings`): B, S, P as
+    patch strings, the imposed end angles, the corner parameters on hub and shroud, the
+    patch count and the measured deviations (:func:`_deviations`), with the tolerances
+    they were held to. What the end caps (step g) are built on."""
+
+    surfaces: dict
+    imposed: dict
+    U_hub: np.ndarray
+    U_shroud: np.ndarray
+    patches: int
+    deviations: dict
+    tolerance: float
+    wall_tolerance: float
+
+
+def blade_step(channel: MeridionalChannel, hub: WallBlade, shroud: WallBlade, n: int, axial: bool, spacing: str):
+    """One construction at ``n`` patches: (surfaces, imposed angles, U_hub, U_shroud,
+    deviations); a pure function of its arguments, so a caller may keep it (:func:`blade_strings`'s ``step``)."""
+    surfaces, imposed, U_hub, U_shroud = _wall_strings(channel, hub, shroud, n, axial, spacing)
+    return surfaces, imposed, U_hub, U_shroud, _deviations(hub, shroud, surfaces, U_hub, U_shroud, axial)
+
+
+def blade_strings(channel: MeridionalChannel, hub: WallBlade, shroud: WallBlade, n_patches: int,
+                  axial_elements: bool = False, tolerance: float = 0.0, wall_tolerance: float | None = None,
+                  spacing: str = "meridional", step=None) -> BladeStrings:
+    """Steps e–f with the adaptive patch count of :func:`build_blade`. ``step(n)``: the
+    construction at n patches (default :func:`blade_step` on these arguments; a caller
+    may pass one that remembers earlier counts, since a tolerance edit revisits them)."""
+    if n_patches < 1:
+        raise GeometryError(f"a blade needs at least one patch, got {n_patches}")
+    if spacing not in PATCH_SPACINGS:
+        raise GeometryError(f"patch spacing must be one of {PATCH_SPACINGS}, got {spacing!r}")
+    if step is None:
+        def step(n):
+            return blade_step(channel, hub, shroud, n, axial_elements, spacing)
+    tol = float(tolerance)
+    wall_tol = tol if wall_tolerance is None else float(wall_tolerance)
+    n = int(n_patches)
+    while True:
+        surfaces, imposed, U_hub, U_shroud, dev = step(n)
+        if tol <= 0.0:
+            break
+        ratio = max(dev["wall_gap"] / wall_tol, dev["camber"] / tol, dev["thickness"] / tol)
+        if ratio <= 1.0 or n >= MAX_PATCHES:
+            break
+        n = min(MAX_PATCHES, max(n + 1, int(np.ceil(n * ratio ** 0.25 * PATCH_MARGIN))))
+    return BladeStrings(surfaces, imposed, U_hub, U_shroud, n, dev, tol, wall_tol)
+
+
 def build_blade(
     channel: MeridionalChannel,
     hub: WallBlade,
@@ -635,6 +754,8 @@ def build_blade(
     tolerance: float = 0.0,
     wall_tolerance: float | None = None,
     spacing: str = "meridional",
+    strings: BladeStrings | None = None,
+    caps: dict | None = None,
 ) -> BladeSurfaces:
     """B, S, P and the end caps of one blade (module docstring, steps a–g).
 
@@ -644,46 +765,45 @@ def build_blade(
     (default: ``tolerance``) and follow steps c–d within ``tolerance``; 0 uses
     ``n_patches`` as given. The caps are fitted to the smaller of the two. The result's
     ``report`` holds the counts, the measured deviations (m) and whether they were met:
-    a count that reaches MAX_PATCHES without meeting them is reported, not refused."""
-    if n_patches < 1:
-        raise GeometryError(f"a blade needs at least one patch, got {n_patches}")
-    if spacing not in PATCH_SPACINGS:
-        raise GeometryError(f"patch spacing must be one of {PATCH_SPACINGS}, got {spacing!r}")
-    tol = float(tolerance)
-    wall_tol = tol if wall_tolerance is None else float(wall_tolerance)
-    n = int(n_patches)
-    while True:
-        surfaces, imposed, U_hub, U_shroud = _wall_strings(channel, hub, shroud, n, axial_elements, spacing)
-        dev = _deviations(hub, shroud, surfaces, U_hub, U_shroud, axial_elements)
-        if tol <= 0.0:
-            break
-        ratio = max(dev["wall_gap"] / wall_tol, dev["camber"] / tol, dev["thickness"] / tol)
-        if ratio <= 1.0 or n >= MAX_PATCHES:
-            break
-        n = min(MAX_PATCHES, max(n + 1, int(np.ceil(n * ratio ** 0.25 * PATCH_MARGIN))))
+    a count that reaches MAX_PATCHES without meeting them is reported, not refused.
+
+    strings: steps e–f already done (:func:`blade_strings` on the same arguments), e.g.
+    kept by a caller across panel edits that change only the end caps; caps: a dict
+    {end: (cap, deviation)} the caps of each end are looked up in and stored to by
+    ``(end, ratio)`` (a caller's memory; only valid for these same strings)."""
+    if strings is None:
+        strings = blade_strings(channel, hub, shroud, n_patches, axial_elements, tolerance, wall_tolerance, spacing)
+    surfaces, imposed, U_hub, U_shroud = strings.surfaces, strings.imposed, strings.U_hub, strings.U_shroud
+    n, dev, tol, wall_tol = strings.patches, strings.deviations, strings.tolerance, strings.wall_tolerance
     cap_tol = min(tol, wall_tol) if tol > 0.0 else np.inf
-    caps, cap_dev = {}, {}
+    built, cap_dev = {}, {}
     for end, ratio_e in ((0, leading_edge_ratio), (1, trailing_edge_ratio)):
         d_hub = float(bernstein_function(hub.thickness, np.array([float(end)]))[0])
         d_shroud = float(bernstein_function((hub if axial_elements else shroud).thickness, np.array([float(end)]))[0])
         if min(d_hub, d_shroud) <= 0.0:
-            caps[end] = None
+            built[end] = None
+            continue
+        key = (end, float(ratio_e))
+        if caps is not None and key in caps:
+            built[end], cap_dev[end] = caps[key]
             continue
         speeds = {"lower": _end_speed(hub, U_hub, spacing)[end]}
         if not axial_elements:
             speeds["upper"] = _end_speed(shroud, U_shroud, spacing)[end]
-        caps[end], cap_dev[end] = end_cap(channel, hub, shroud, surfaces, end, ratio_e, axial_elements, speeds,
-                                          cap_tol)
+        built[end], cap_dev[end] = end_cap(channel, hub, shroud, surfaces, end, ratio_e, axial_elements, speeds,
+                                           cap_tol)
+        if caps is not None:
+            caps[key] = (built[end], cap_dev[end])
     report = dict(dev)
     report.update({
         "patches": n, "spacing": spacing, "tolerance": tol, "wall_tolerance": wall_tol,
-        "cap_patches": tuple(None if caps[e] is None else caps[e].count for e in (0, 1)),
+        "cap_patches": tuple(None if built[e] is None else built[e].count for e in (0, 1)),
         "cap_deviation": max(cap_dev.values(), default=0.0),
     })
     report["met"] = tol <= 0.0 or (dev["wall_gap"] <= wall_tol and dev["camber"] <= tol and dev["thickness"] <= tol
                                    and report["cap_deviation"] <= cap_tol)
     return BladeSurfaces(
-        surfaces["B"], surfaces["S"], surfaces["P"], caps[0], caps[1], np.vstack([U_hub, U_shroud]), imposed,
+        surfaces["B"], surfaces["S"], surfaces["P"], built[0], built[1], np.vstack([U_hub, U_shroud]), imposed,
         axial_elements, report,
     )
 

@@ -22,6 +22,10 @@ trimmed the way the propeller hub sector is (Hally 2013 §10–11, IGES 144 over
   and the parameter-space curves are approximations of their (u, φ) images
   (:func:`..nurbs.approximate`), so the 142s prefer the model-space curve.
 
+A standardised impeller (Casey 1983, Fig. 11) has the walls of its new channel and the
+blades trimmed to it (:mod:`.standardisation`, edges on the new walls), footprints and
+sector sides taken from the trimmed surfaces.
+
 A single passage is one sector of hub and shroud with the reference blade (and splitter):
 after sewing, its only free edges are the inlet, the outlet and the periodic sides. The
 full wheel is Z sectors and Z blades: its free edges are the inlet and outlet circles.
@@ -36,6 +40,7 @@ import numpy as np
 
 from ..errors import GeometryError
 from ..nurbs import BSplineCurve, BSplineSurface, approximate, interpolate, reverse
+from ..nurbs.fitting import greville_abscissae, interpolate_at
 from .bezier import BezierString
 from .blade import wall_foot
 from .definition import ImpellerModel
@@ -111,7 +116,31 @@ def _pcurve(contour: WallContour, wall: BezierString, model: BSplineCurve, U_gue
         return np.stack([contour.u_of_U(U), phi], axis=1)
 
     inner = np.unique(model.knots[(model.knots > a) & (model.knots < b)])
-    return approximate(func, PCURVE_TOLERANCE, degree=3, domain=(a, b), initial_knots=inner)
+    try:
+        return approximate(func, PCURVE_TOLERANCE, degree=3, domain=(a, b), initial_knots=inner)
+    except GeometryError:
+        # a trimmed (standardised) edge's knots can be too uneven for the adaptive
+        # approximation (it met a singular interpolation system): interpolate at the
+        # Greville abscissae of uniform knots, doubled until the tolerance is met
+        return _uniform_pcurve(func, a, b)
+
+
+#: Uniform-knot fallback of :func:`_pcurve`: first and largest number of spans.
+UNIFORM_PCURVE_SPANS = (32, 4096)
+
+
+def _uniform_pcurve(func, a: float, b: float) -> BSplineCurve:
+    """Cubic interpolant of ``func`` at the Greville abscissae of uniform knots on [a, b]
+    (The NURBS Book 2e §9.2.1), the span count doubled until the largest deviation at the
+    span midpoints is within PCURVE_TOLERANCE; the last one tried is returned otherwise."""
+    n, most = UNIFORM_PCURVE_SPANS
+    while True:
+        knots = np.r_[np.full(4, a), np.linspace(a, b, n + 1)[1:-1], np.full(4, b)]
+        curve = interpolate_at(knots, 3, greville_abscissae(knots, 3), func(greville_abscissae(knots, 3)))
+        t = np.linspace(a, b, 4 * n + 1)
+        if np.max(np.abs(curve.evaluate(t) - func(t))) <= PCURVE_TOLERANCE or n >= most:
+            return curve
+        n *= 2
 
 
 def _signed_area(curves) -> float:
@@ -179,17 +208,17 @@ def _line(p0, p1) -> BSplineCurve:
     return BSplineCurve(1, np.array([0.0, 0.0, 1.0, 1.0]), np.array([p0, p1], dtype=float))
 
 
-def _side(model: ImpellerModel, which: str, contour: WallContour, offset: float) -> list:
+def _side(model: ImpellerModel, which: str, contour: WallContour, offset: float, B: BSplineSurface,
+          corners) -> list:
     """The lower periodic side of the passage sector on wall ``which``: a straight piece at
     the LE angle from the inlet, the camber line φ_B(U) + offset between LE and TE (a cubic
-    interpolating it), a straight piece at the TE angle to the outlet; in (u, φ)."""
-    blade = model.blade
+    interpolating it; B the camber surface whose edges lie on the walls, ``corners`` its
+    corner parameters or NaN), a straight piece at the TE angle to the outlet; in (u, φ)."""
     v = 0.0 if which == "hub" else 1.0
     wall = model.channel.wall(which)
-    B = dict(blade_surfaces(blade, include_camber=True))["B"]
     edge = _edge_curve(B, v)
     t = np.linspace(*edge.domain, SIDE_POINTS)
-    corner_U = blade.corner_U[0 if which == "hub" else 1]
+    corner_U = corners[0 if which == "hub" else 1]
     if np.isfinite(corner_U).all():
         guess = np.interp(t, np.linspace(*edge.domain, len(corner_U)), corner_U)
     else:
@@ -236,9 +265,6 @@ class CfdSet:
 def cfd_set(model: ImpellerModel, full_wheel: bool = False, include_camber: bool = False) -> CfdSet:
     """The single passage (one sector of hub and shroud, the reference blade and splitter)
     or the full wheel (Z sectors and Z blades), module docstring."""
-    if model.standardisation is not None:
-        raise GeometryError("the CFD set of a standardised impeller is not available yet; export it without "
-                            "the standardisation or as separate surfaces")
     Z = model.count
     pitch = 2.0 * math.pi / Z
     a = -0.5
@@ -247,16 +273,26 @@ def cfd_set(model: ImpellerModel, full_wheel: bool = False, include_camber: bool
         f = _splitter_fraction(model)
         a = 0.5 * (f - 1.0)
     references = [("blade", model.blade)] + ([("splitter", model.splitter)] if model.splitter is not None else [])
-    ref_surfaces = {label: dict(blade_surfaces(b, include_camber)) for label, b in references}
+    std = model.standardisation
+    if std is None:
+        ref_surfaces = {label: dict(blade_surfaces(b, include_camber)) for label, b in references}
+        corners = {label: b.corner_U for label, b in references}
+        camber = dict(blade_surfaces(model.blade, include_camber=True))["B"]
+    else:
+        # standardised (Casey 1983, Fig. 11): the blades trimmed to the new channel, whose
+        # edges lie on its walls; their wall parameters are found by search
+        ref_surfaces = {label: dict(std.surfaces(label, include_camber)) for label, _ in references}
+        corners = {label: np.full((2, 2), np.nan) for label, _ in references}
+        camber = std.trimmed("blade", "B").surface
     walls, blades = [], []
     count = Z if full_wheel else 1
     diameter = 0.0
     for which in ("hub", "shroud"):
         string = model.channel.wall(which)
         contour = wall_contour(string)
-        lower = _side(model, which, contour, a * pitch)
-        holes0 = [_footprint(ref_surfaces[label], which, contour, string, b.corner_U[0 if which == "hub" else 1])
-                  for label, b in references]
+        lower = _side(model, which, contour, a * pitch, camber, corners["blade"])
+        holes0 = [_footprint(ref_surfaces[label], which, contour, string, corners[label][0 if which == "hub" else 1])
+                  for label, _ in references]
         for k in range(count):
             shift = k * pitch
             low = [_shifted(c, shift) for c in lower]

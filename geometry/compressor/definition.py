@@ -62,7 +62,8 @@ import numpy as np
 from ..errors import DefinitionError, GeometryError
 from ..validation import MAX_LENGTH, MIN_LENGTH, check_count, check_keys, number, number_list, read_toml, string, table
 from .blade import (DEFAULT_TOLERANCE, MAX_BETA_DEG, PATCH_SPACINGS, WALL_TOLERANCE, BladeSurfaces, WallBlade,
-                    WallCamber, build_blade, outer_diameter)
+                    WallCamber, blade_step, blade_strings, build_blade, outer_diameter)
+from .memo import MEMORY
 from .channel import MeridionalChannel, WallSkeleton, channel_from_skeleton
 from .standardisation import Standardisation
 from .uses import CutError, scaled_channel
@@ -409,6 +410,8 @@ class ImpellerDefinition:
     splitter: SplitterDefinition | None = None
     path: str | None = field(default=None, compare=False)
     standardisation: StandardisationDefinition | None = None  # None: the master itself
+    #: Take pieces built before from the same values from :data:`.memo.MEMORY` (False: build all).
+    memoise: bool = field(default=True, compare=False)
 
     @classmethod
     def from_dict(cls, data: dict, path=None) -> "ImpellerDefinition":
@@ -494,14 +497,26 @@ class ImpellerDefinition:
             raise exc.with_path(self.path) from None
 
     def _build(self) -> ImpellerModel:
-        channel = self.channel.build(self.path)
+        """The model, its pieces taken from :data:`.memo.MEMORY` when built before from the
+        same values (a panel edit rebuilds only what it changes)."""
+        memory = MEMORY if self.memoise else None
+
+        def kept(key, build):
+            return build() if memory is None else memory.get(key, build)
+
+        channel_key = repr(self.channel.to_dict())
+        channel = kept(("channel", channel_key), lambda: self.channel.build(self.path))
         self._check_blade(channel.count)
         b = self.blade
+        camber_keys = {
+            w: (channel_key, w, getattr(b, f"leading_edge_{w}"), getattr(b, f"trailing_edge_{w}"),
+                tuple(getattr(b, f"beta_{w}")), getattr(b, f"lean_{w}"))
+            for w in WALLS
+        }
         cambers = {
-            w: WallCamber(
+            w: kept(("camber",) + camber_keys[w], lambda w=w: WallCamber(
                 channel.wall(w), getattr(b, f"leading_edge_{w}"), getattr(b, f"trailing_edge_{w}"),
-                getattr(b, f"beta_{w}"), math.radians(getattr(b, f"lean_{w}")),
-            )
+                getattr(b, f"beta_{w}"), math.radians(getattr(b, f"lean_{w}"))))
             for w in WALLS
         }
         axial = b.elements == "axial"
@@ -512,8 +527,24 @@ class ImpellerDefinition:
         size = outer_diameter(walls["hub"], walls["shroud"])
         tol = b.tolerance * size
         wall_tol = min(b.tolerance, WALL_TOLERANCE) * size if b.tolerance > 0.0 else None
-        blade = build_blade(channel, walls["hub"], walls["shroud"], b.patches, axial, b.leading_edge_ratio,
-                            b.trailing_edge_ratio, tol, wall_tol, b.patch_spacing)
+
+        def one_blade(label, wb, thickness_key, patches, le_ratio):
+            base = (label, camber_keys["hub"], camber_keys["shroud"], thickness_key, axial, b.patch_spacing)
+
+            def step(n):
+                return kept(("step",) + base + (n,),
+                            lambda: blade_step(channel, wb["hub"], wb["shroud"], n, axial, b.patch_spacing))
+
+            strings_key = base + (patches, tol, wall_tol)
+            strings = kept(("strings",) + strings_key, lambda: blade_strings(
+                channel, wb["hub"], wb["shroud"], patches, axial, tol, wall_tol, b.patch_spacing, step))
+            caps = kept(("caps",) + strings_key, dict)
+            return kept(("blade",) + strings_key + (le_ratio, b.trailing_edge_ratio), lambda: build_blade(
+                channel, wb["hub"], wb["shroud"], patches, axial, le_ratio, b.trailing_edge_ratio, tol, wall_tol,
+                b.patch_spacing, strings=strings, caps=caps if memory is not None else None))
+
+        blade = one_blade("blade", walls, (tuple(b.thickness_hub), tuple(b.thickness_shroud)), b.patches,
+                          b.leading_edge_ratio)
         splitter = None
         s = self.splitter
         if s is not None:
@@ -523,15 +554,19 @@ class ImpellerDefinition:
                              np.asarray(getattr(s, f"thickness_{w}")), offset)
                 for w in WALLS
             }
-            splitter = build_blade(channel, swalls["hub"], swalls["shroud"], s.patches, axial, s.leading_edge_ratio,
-                                   b.trailing_edge_ratio, tol, wall_tol, b.patch_spacing)
+            splitter = one_blade(("splitter", s.leading_edge_hub, s.leading_edge_shroud, offset), swalls,
+                                 (tuple(s.thickness_hub), tuple(s.thickness_shroud)), s.patches, s.leading_edge_ratio)
         st = self.standardisation
         if st is None or st.is_identity:
             return ImpellerModel(self.name, channel, blade, splitter, b.count)
-        standardisation = self._standardise(channel, blade, splitter)
+        new_channel = kept(("scaled channel", channel_key, st.shroud_factor, st.hub_factor),
+                           lambda: scaled_channel(channel, st.shroud_factor, st.hub_factor))
+        standardisation = kept(("standardisation", id(blade), id(splitter), id(new_channel)),
+                               lambda: self._standardise(channel, blade, splitter, new_channel))
         return ImpellerModel(self.name, standardisation.channel, blade, splitter, b.count, standardisation)
 
-    def _standardise(self, master: MeridionalChannel, blade: BladeSurfaces, splitter) -> Standardisation:
+    def _standardise(self, master: MeridionalChannel, blade: BladeSurfaces, splitter,
+                     channel: MeridionalChannel | None = None) -> Standardisation:
         """The new channel and the trimmed blades (Casey 1983, Fig. 11); failures are
         reported against the factor of the wall concerned."""
         st, p = self.standardisation, self.path
@@ -545,7 +580,8 @@ class ImpellerDefinition:
             # the wall concerned did not move: the factor that did is to blame
             return "standardisation.shroud_factor" if st.shroud_factor != 1.0 else "standardisation.hub_factor"
 
-        channel = scaled_channel(master, st.shroud_factor, st.hub_factor)
+        if channel is None:
+            channel = scaled_channel(master, st.shroud_factor, st.hub_factor)
         try:
             channel.check(p)
         except DefinitionError as exc:

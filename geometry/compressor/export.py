@@ -8,6 +8,8 @@ A standardised impeller has the walls of its new channel and the trimmed blades 
 """
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from ..nurbs import BSplineSurface
@@ -18,6 +20,9 @@ from .definition import ImpellerModel
 
 #: A knot-reduced form is used only if it reproduces the Bézier form to this (relative).
 REDUCTION_TOLERANCE = 1e-12
+#: Samples per patch at which a knot-reduced form is compared with the Bézier form (a
+#: string that is not smooth enough differs all along the patches next to the junction).
+REDUCTION_SAMPLES = 10
 
 
 def _reduced_string(string: BezierString, multiplicity: int, spans=None):
@@ -34,7 +39,7 @@ def _reduced_string(string: BezierString, multiplicity: int, spans=None):
     k = np.clip(np.searchsorted(breaks, g, side="right") - 1, 0, n - 1)
     U = k + (g - breaks[k]) / h[k]
     curve = interpolate_at(knots, p, g, string.elevated_to(p).evaluate(U))
-    test = np.linspace(0.0, breaks[-1], 40 * n + 1)
+    test = np.linspace(0.0, breaks[-1], REDUCTION_SAMPLES * n + 1)
     kt = np.clip(np.searchsorted(breaks, test, side="right") - 1, 0, n - 1)
     ref = string.evaluate(kt + (test - breaks[kt]) / h[kt])
     scale = max(1.0, float(np.abs(ref).max()))
@@ -43,9 +48,27 @@ def _reduced_string(string: BezierString, multiplicity: int, spans=None):
     return curve
 
 
+#: The B-spline forms already made of patch strings and wall contours (the model objects
+#: are immutable and shared by every model built from the same values, :mod:`.memo`, so a
+#: panel edit converts only what it changed); dropped with the object they belong to.
+_CONVERTED = weakref.WeakKeyDictionary()
+
+
+def _converted(obj, make):
+    try:
+        return _CONVERTED[obj]
+    except KeyError:
+        value = _CONVERTED[obj] = make(obj)
+        return value
+
+
 def ruled_bspline(surface: PatchString) -> BSplineSurface:
     """A cubic-linear patch string as a degree (3, 1) B-spline with simple interior knots
-    when it is C2 (Casey's blades), else in Bézier form."""
+    when it is C2 (Casey's blades), else in Bézier form (made once per string)."""
+    return _converted(surface, _ruled_bspline)
+
+
+def _ruled_bspline(surface: PatchString) -> BSplineSurface:
     lo = _reduced_string(surface.lower, 1)
     up = _reduced_string(surface.upper, 1)
     if lo is None or up is None:
@@ -94,7 +117,11 @@ def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
     """A wall of revolution as four quarter surfaces (φ in [qπ/2, (q+1)π/2]), each one
     exact rational quadratic arc in v, so that none is closed and none has a C0 knot in v, with the contour made C1 by choosing the knot spans so that the first
     derivatives match at the junctions (the channel is G2; interior knots of
-    multiplicity p - 1), falling back to the Bézier form."""
+    multiplicity p - 1), falling back to the Bézier form (made once per string)."""
+    return list(_converted(string, _channel_wall_quarters))
+
+
+def _channel_wall_quarters(string: BezierString) -> tuple:
     contour, _ = reduced_contour(string)
     knots_c, circle, w_circle = full_circle()
     out = []
@@ -108,7 +135,7 @@ def channel_wall_quarters(string: BezierString) -> list[BSplineSurface]:
         P[..., 2] = z[:, None]
         kv = np.array([0.0, 0, 0, 1, 1, 1]) * 0.5 * np.pi + 0.5 * np.pi * q
         out.append(BSplineSurface(contour.degree, 2, contour.knots, kv, P, np.ones(len(z))[:, None] * w[None, :]))
-    return out
+    return tuple(out)
 
 
 def blade_surfaces(blade, include_camber: bool = False) -> list[tuple[str, BSplineSurface]]:

@@ -69,7 +69,9 @@ from scipy.optimize import minimize
 from ..errors import DefinitionError, GeometryError
 from ..nurbs import closest_point_curve, closest_point_surface
 from .channel import MeridionalChannel
-from .fitting import fit_channel, fit_ruled_surface, trim_lines_to_channel
+from .blade import WALL_TOLERANCE
+from .fitting import (EXTENSION_MARGIN, edges_on_walls, extend_channel, fit_channel, fit_general_surface,
+                      fit_ruled_surface, trim_lines_to_channel)
 
 UNITS = {"m": 1.0, "mm": 1e-3}
 #: Default fit tolerance as a fraction of the largest radius of the data.
@@ -117,16 +119,32 @@ class FittedImpeller:
     count: int
     deviation: dict = field(default_factory=dict)
     tolerance: float = 0.0
+    wall_gap: dict = field(default_factory=dict)  # {"<blade> S|P": largest edge-to-wall distance (m)}
+    wall_tolerance: float = 0.0
+    patches: dict = field(default_factory=dict)  # {"<blade> S|P": cubic-linear patches}
+    extended: bool = False  # the walls' end patches were continued to hold the blades
+    general: dict = field(default_factory=dict)  # {"<blade> S|P": BSplineSurface} where the ruled fit missed
+    ruled_deviation: dict = field(default_factory=dict)  # {"<blade> S|P": the ruled fit's deviation} for those
 
     @property
     def met(self) -> bool:
-        """Whether every surface lies within the tolerance of its points."""
-        return all(v <= self.tolerance for v in self.deviation.values())
+        """Whether every surface lies within the tolerance of its points and every blade
+        edge on its wall within the wall tolerance."""
+        return (all(v <= self.tolerance for v in self.deviation.values())
+                and all(g <= self.wall_tolerance for g in self.wall_gap.values()))
 
     def summary(self) -> str:
         parts = [f"{k} {v * 1e3:.4f} mm" for k, v in self.deviation.items()]
         head = "" if self.met else "tolerance NOT met: "
-        return f"{head}{self.name}: fitted to {self.tolerance * 1e3:.4g} mm; deviation " + ", ".join(parts)
+        text = f"{head}{self.name}: fitted to {self.tolerance * 1e3:.4g} mm; deviation " + ", ".join(parts)
+        if self.wall_gap:
+            text += (f"; edges on the walls within {max(self.wall_gap.values()) * 1e3:.2g} mm "
+                     f"(tolerance {self.wall_tolerance * 1e3:.2g} mm); patches "
+                     + ", ".join(f"{k} {v}" for k, v in self.patches.items()))
+        if self.general:
+            text += "; general B-spline surfaces for " + ", ".join(
+                f"{k} (ruled fit {self.ruled_deviation[k] * 1e3:.4f} mm)" for k in self.general)
+        return text
 
 
 class PointFile:
@@ -332,25 +350,38 @@ def _split_loop(loop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (forward, backward) if phi[0] > phi[1] else (backward, forward)
 
 
-def fit_impeller(points: PointFile, tolerance: float | None = None) -> FittedImpeller:
+def fit_impeller(points: PointFile, tolerance: float | None = None,
+                 wall_tolerance: float | None = None, general: bool = False) -> FittedImpeller:
     """Fit the channel and every blade side of ``points`` to ``tolerance`` (metres; default
     DEFAULT_TOLERANCE_FRACTION of the largest data radius) and measure each surface's
-    largest distance from its points (true closest points, The NURBS Book 2e §6.1)."""
+    largest distance from its points (true closest points, The NURBS Book 2e §6.1).
+
+    The blade edges are put on the channel walls (:func:`.fitting.edges_on_walls`) within
+    ``wall_tolerance`` (default WALL_TOLERANCE × the outer diameter, 2 × the largest data
+    radius, as for the presets); where the data lines reach past the contour data, the
+    walls' end patches are continued to hold them (:func:`.fitting.extend_channel`).
+
+    general: a side whose best ruled surface misses its points by more than the
+    tolerance is fitted again by a general B-spline surface (cubic in v, the same edges on
+    the walls; :func:`.fitting.fit_general_surface`); both deviations are reported."""
     hub, shroud = points.walls["hub"], points.walls["shroud"]
     size = float(max(hub[:, 1].max(), shroud[:, 1].max()))
     tol = DEFAULT_TOLERANCE_FRACTION * size if tolerance is None else float(tolerance)
     if not tol > 0.0:
         raise DefinitionError(f"the tolerance must be > 0, got {tolerance!r}", field="tolerance")
+    wall_tol = WALL_TOLERANCE * 2.0 * size if wall_tolerance is None else float(wall_tolerance)
+    if not wall_tol > 0.0:
+        raise DefinitionError(f"the wall tolerance must be > 0, got {wall_tolerance!r}", field="wall_tolerance")
     channel = fit_channel(hub, shroud, tolerance=tol)
     deviation = {
         "hub": float(closest_point_curve(channel.hub.to_bspline(), hub)[1].max()),
         "shroud": float(closest_point_curve(channel.shroud.to_bspline(), shroud)[1].max()),
     }
-    blades = {}
+    # first pass: ruled fits to the trimmed lines, and how far along each wall they reach
+    ruled, reach = {}, np.array([[0.0, channel.count], [0.0, channel.count]])
     for b in points.blades:
-        sides = {}
         for side, lines in b["lines"].items():
-            trimmed = trim_lines_to_channel(lines, channel)
+            trimmed, U = trim_lines_to_channel(lines, channel, parameters=True)
             s = np.linspace(0.0, 1.0, SAMPLES_PER_LINE)
             P = trimmed[:, 0, None] + s[None, :, None] * (trimmed[:, 1] - trimmed[:, 0])[:, None]
             inside = np.ones(P.shape[:2], bool) if b["radius_max"] is None else \
@@ -358,13 +389,28 @@ def fit_impeller(points: PointFile, tolerance: float | None = None) -> FittedImp
             used = inside.any(axis=1)
             if used.sum() < 4:
                 raise GeometryError(f"blade {b['name']} {side}: {used.sum()} lines inside the channel; need 4")
-            surface, _ = fit_ruled_surface(trimmed[used, 0], trimmed[used, 1], tol)
+            surface, _, knots = fit_ruled_surface(trimmed[used, 0], trimmed[used, 1], tol, knots=True)
             measured = P[used][inside[used]] if b["points"] is None else b["points"][side]
-            _, _, dist = closest_point_surface(surface.to_bspline(), measured)
-            sides[side] = surface
-            deviation[f"{b['name']} {side}"] = float(dist.max())
-        blades[b["name"]] = sides
-    return FittedImpeller(points.name, channel, blades, points.count, deviation, tol)
+            ruled[(b["name"], side)] = (surface, knots, measured)
+            reach[:, 0] = np.minimum(reach[:, 0], U[used].min(axis=0) - EXTENSION_MARGIN)
+            reach[:, 1] = np.maximum(reach[:, 1], U[used].max(axis=0) + EXTENSION_MARGIN)
+    extended = bool(np.any(reach[:, 0] < 0.0) or np.any(reach[:, 1] > channel.count))
+    if extended:
+        channel = extend_channel(channel, reach[0], reach[1])
+    blades, gaps, patches, general_surfaces, ruled_deviation = {}, {}, {}, {}, {}
+    for (name, side), (surface, knots, measured) in ruled.items():
+        surface, gap = edges_on_walls(surface, channel, wall_tol, knots)
+        _, _, dist = closest_point_surface(surface.to_bspline(), measured)
+        blades.setdefault(name, {})[side] = surface
+        key = f"{name} {side}"
+        deviation[key] = float(dist.max())
+        gaps[key] = gap
+        patches[key] = surface.count
+        if general and deviation[key] > tol:
+            general_surfaces[key], g, gaps[key] = fit_general_surface(surface, measured, channel, wall_tol)
+            ruled_deviation[key], deviation[key] = deviation[key], g
+    return FittedImpeller(points.name, channel, blades, points.count, deviation, tol, gaps, wall_tol, patches,
+                          extended, general_surfaces, ruled_deviation)
 
 
 def fitted_surfaces(fitted: FittedImpeller, blades: int | None = None) -> list:
@@ -377,7 +423,8 @@ def fitted_surfaces(fitted: FittedImpeller, blades: int | None = None) -> list:
         for i, s in enumerate(channel_wall_quarters(fitted.channel.wall(wall))):
             out.append((f"{wall} {i + 1}", s))
     count = fitted.count if blades is None else int(blades)
-    ref = {name: {side: ruled_bspline(ps) for side, ps in sides.items()} for name, sides in fitted.blades.items()}
+    ref = {name: {side: fitted.general.get(f"{name} {side}") or ruled_bspline(ps) for side, ps in sides.items()}
+           for name, sides in fitted.blades.items()}
     from ..nurbs import BSplineSurface
     for k in range(count):
         a = 2.0 * math.pi * k / fitted.count

@@ -104,3 +104,22 @@ def test_gmsh_meshes_every_face_of_the_passage(tmp_path):
     finally:
         gmsh.logger.stop()
         gmsh.finalize()
+
+
+def test_standardised_passage_sews_closed_but_inlet_outlet_and_periodic_sides(tmp_path):
+    """A standardised impeller (Casey 1983, Fig. 11: intermediate_flow with a 20 % shroud
+    cut) has a CFD set too: the new channel's walls trimmed at the footprints of the
+    trimmed blades; OCC reads it with 0 messages and it sews like the master's."""
+    d = ImpellerDefinition.from_toml(PRESETS / "intermediate_flow.toml")
+    data = d.to_dict()
+    data["standardisation"] = {"shroud_factor": 0.8}
+    model = type(d).from_dict(data).build()
+    cfd = cfd_set(model)
+    path = tmp_path / "standardised_passage.igs"
+    write_cfd_iges(path, cfd, units="mm")
+    res = read_with_occ(path)
+    assert res.load_messages == [] and res.transfer_messages == []
+    assert len(res.faces) == 2 + 4 * 2 and all(is_valid(f) for f in res.faces)  # blade and splitter
+    sewing, mids = sew(res.faces, SEWING_FRACTION * cfd.diameter * 1000.0)
+    ends = on_inlet_or_outlet(model, mids)
+    assert ends.sum() == 4 and (~ends).sum() == 12, mids
