@@ -341,14 +341,24 @@ def _collocation(knots: np.ndarray, degree: int, n_control: int, params: np.ndar
 class _SpanLookup:
     """find_span (NURBS Book Alg. A2.1) for many parameters through a table of uniform
     bins: bin j starts from the span of the start of bin j - 1 (safe against rounding of
-    the bin index), and each parameter steps up while U[span + 1] <= u. The result is
-    exactly that of :func:`.basis.find_span` for parameters in the domain; a binary
-    search per parameter (``searchsorted``) costs several times more on scattered
-    parameters."""
+    the bin index), and each parameter steps up while U[span + 1] <= u. When the bins are
+    fine enough that no two distinct knots lie within two neighbouring bins (up to
+    :data:`SPAN_BINS_MAX` bins), one step decides: span = the stepped span of the bin
+    where u >= its next knot. The result is exactly that of :func:`.basis.find_span` for
+    parameters in the domain; a binary search per parameter (``searchsorted``) costs
+    several times more on scattered parameters."""
 
     def __init__(self, knots: np.ndarray, degree: int):
         a, b = domain_of(knots, degree)
-        n_bins = int(min(SPAN_BINS_MAX, SPAN_BINS_PER_KNOT * len(knots)))
+        inner = np.unique(knots[(knots >= a) & (knots <= b)])
+        n_bins = SPAN_BINS_PER_KNOT * len(knots)
+        gap = float(np.min(np.diff(inner))) if inner.size > 1 else b - a
+        # three bins per smallest gap: a window of two bins then holds at most one knot
+        fine = int(np.ceil(3.0 * (b - a) / gap)) if gap > 0 else SPAN_BINS_MAX + 1
+        self.one_step = fine <= SPAN_BINS_MAX
+        if self.one_step:
+            n_bins = max(n_bins, fine)
+        n_bins = int(min(SPAN_BINS_MAX, n_bins))
         width = (b - a) / n_bins
         self.knots = knots
         self.start = a
@@ -358,10 +368,17 @@ class _SpanLookup:
         edges[0] = a
         self.first = find_span(knots, degree, np.clip(edges, a, b))
         self.last = int(find_span(knots, degree, np.array([b]))[0])
+        if self.one_step:
+            # the next knot above each bin's first span, and the span that starts there
+            top = np.minimum(self.first + 1, len(knots) - 1)
+            self.next_knot = np.where(self.first < self.last, knots[top], np.inf)
+            self.stepped = find_span(knots, degree, np.clip(np.minimum(self.next_knot, b), a, b))
 
     def __call__(self, u: np.ndarray) -> np.ndarray:
         j = ((u - self.start) * self.scale).astype(np.intp)
         np.clip(j, 0, self.n_bins - 1, out=j)
+        if self.one_step:
+            return np.where(u >= self.next_knot[j], self.stepped[j], self.first[j])
         span = self.first[j]
         knots, last = self.knots, self.last
         while True:
