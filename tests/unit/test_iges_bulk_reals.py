@@ -28,6 +28,8 @@ def cases():
     ])
     yield rng.normal(size=SHORTEST_REPR_SIZE + 1)  # the smallest bulk array
     yield np.abs(rng.normal(size=5000)) + 1e-3  # no special values at all
+    yield np.arange(1.0, 400.0)  # only special values (integers)
+    yield 1e-5 * np.arange(1, 400)  # only special values (exponent form)
 
 
 def test_bulk_reals_are_printf_17g_and_round_trip():
