@@ -99,7 +99,12 @@ BULK_CHUNK = 1 << 12
 _POW10 = 10.0 ** np.arange(23)
 #: Veltkamp's splitting constant 2**27 + 1: exact products without a fused multiply-add.
 _SPLIT = 134217729.0
-_DIGIT_POW = 10.0 ** np.arange(9, -1, -1)
+#: The characters of 0000 .. 9999 as little-endian 4-byte words (first character lowest).
+_FOUR_DIGITS = np.frombuffer("".join(f"{i:04d}" for i in range(10**4)).encode("ascii"), dtype="<u4")
+#: Trailing zero digits of 0000 .. 9999 (4 for 0000).
+_TRAILING_ZEROS = np.array([len(f"{i:04d}") - len(f"{i:04d}".rstrip("0")) for i in range(10**4)], dtype=np.int64)
+#: Word masks keeping the first 4, 3, 2, 1, 0 characters.
+_KEEP_MASK = np.array([0xFFFFFFFF, 0x00FFFFFF, 0x0000FFFF, 0x000000FF, 0], dtype="<u4")
 _COMMA, _DOT, _ZERO, _MINUS, _HOLE = (ord(c) for c in ",.0-#")
 
 
@@ -142,16 +147,25 @@ def _bulk_reals(a: np.ndarray) -> str:
             break
         t[wrong] += np.where(D[wrong] < 10**16, 1, -1)
         D[wrong] = _scaled_integers(m[wrong], t[wrong])
-    # the 17 digits, by exact float arithmetic on two halves below 10**9
-    head = D // 10**8
-    digits = np.empty((D.size, 17), dtype=np.uint8)
-    for half, cols in ((head.astype(np.float64), slice(0, 9)), ((D - head * 10**8).astype(np.float64), slice(9, 17))):
-        width = cols.stop - cols.start
-        Q = np.floor(half[:, None] / _DIGIT_POW[-width - 1 :])
-        digits[:, cols] = (Q[:, 1:] - 10.0 * Q[:, :-1]).astype(np.uint8)
-    last = 16 - np.argmax(digits[:, ::-1] != 0, axis=1)  # the fraction is never all zero
-    digits += _ZERO
-    digits[np.arange(17) > last[:, None]] = 0  # dropped, as "%g" drops trailing zeros
+    # the 17 digits as five little-endian 4-byte words: the leading digit in the last byte
+    # of the first word, then four groups of four looked up in a table of "0000".."9999";
+    # trailing zeros of the fraction are dropped (as "%g" drops them) by zeroing their
+    # bytes (the fraction is never all zero)
+    words = np.empty((D.size, 5), dtype="<u4")
+    rest = D
+    trailing = np.zeros(D.size, dtype=np.int64)
+    all_zero = np.ones(D.size, dtype=bool)
+    for col in (4, 3, 2, 1):
+        group = rest % 10**4
+        rest = rest // 10**4
+        words[:, col] = np.take(_FOUR_DIGITS, group)
+        trailing += np.where(all_zero, np.take(_TRAILING_ZEROS, group), 0)
+        all_zero &= group == 0
+    words[:, 0] = (_ZERO + rest.astype("<u4")) << 24
+    for col in (4, 3, 2, 1):  # zeros dropped from this word: min(4, max(0, trailing - 4 (4 - col)))
+        drop = np.clip(trailing - 4 * (4 - col), 0, 4)
+        words[:, col] &= np.take(_KEEP_MASK, drop)
+    digits = words.view(np.uint8)[:, 3:]  # (n, 17)
     rows = np.zeros((D.size, 24), dtype=np.uint8)  # sign, up to 22 characters, comma
     rows[:, 0] = np.where(a < 0, _MINUS, 0)
     rows[:, 23] = _COMMA
