@@ -94,7 +94,7 @@ def _reals(values) -> str:
 
 # -- bulk reals: "%.17g" by array arithmetic --------------------------------------------------
 #: Reals formatted per numpy pass: keeps the (chunk, 24) byte temporaries in cache.
-BULK_CHUNK = 1 << 12
+BULK_CHUNK = 1 << 13
 #: 10**k for k = 0..22, all exact doubles.
 _POW10 = 10.0 ** np.arange(23)
 #: Veltkamp's splitting constant 2**27 + 1: exact products without a fused multiply-add.
