@@ -179,7 +179,8 @@ class BSplineSurface:
         windows = np.lib.stride_tricks.sliding_window_view(net, (p + 1, q + 1), axis=(0, 1))
         # v power first: table[patch, b, a, :] multiplies (v - m_v)^b (u - m_u)^a, so that a
         # pair's gathered (q+1, (p+1) dim') block is contracted with the v monomials by one
-        # batched product and the (p+1, dim') result with the u monomials (Horner-free)
+        # batched product and the (p+1, dim') result with the u monomials, with no
+        # (n, (p+1)(q+1)) outer product of the monomials
         table = np.einsum("iac,jbd,ijecd->ijbae", Tu, Tv, windows, optimize=True)
         table = np.ascontiguousarray(table.reshape(Tu.shape[0] * Tv.shape[0], q + 1, (p + 1) * net.shape[2]))
         table.flags.writeable = False
