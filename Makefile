@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 OUT    ?= out
 
-.PHONY: demo test test-unit bench clean
+.PHONY: demo test test-unit bench bench-all clean
 
 $(STAMP): requirements.txt requirements-test.txt scripts/system-deps.sh
 	bash scripts/system-deps.sh
@@ -23,7 +23,13 @@ test: $(STAMP)
 test-unit: $(STAMP)
 	$(PY) -m pytest tests/unit
 
+# bench: the product's figures as one markdown table (bench/summary.py calls each bench
+# module's figures()); bench-all: every bench module's detailed printout (bench/run.py).
 bench: $(STAMP)
+	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-bench.txt
+	$(PY) bench/summary.py $(BENCH)
+
+bench-all: $(STAMP)
 	$(PY) -m pip install --quiet --disable-pip-version-check -r requirements-bench.txt
 	$(PY) bench/run.py $(BENCH)
 

@@ -108,17 +108,15 @@ def time_occ(faces, path) -> float:
     return dt
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=7)
-    ap.add_argument("--surfaces", type=int, default=100)
-    ap.add_argument("--size", type=int, default=40)
-    args = ap.parse_args([] if argv is None else argv)
+GOAL_RATIO = 0.5
 
+
+def measure(repeat: int = 7, count: int = 100, size: int = 40) -> dict:
+    """Median write times of ours and OCC's writer, interleaved in the same run."""
     _load_bladesmith()
     from bladesmith.iges import surface_from_geometry
 
-    surfaces = random_surfaces(args.surfaces, args.size)
+    surfaces = random_surfaces(count, size)
     records = [surface_from_geometry(s) for s in surfaces]
     try:
         faces = occ_faces(surfaces)
@@ -128,20 +126,38 @@ def main(argv=None) -> int:
         ours_path = os.path.join(tmp, "ours.igs")
         occ_path = os.path.join(tmp, "occ.igs")
         ours, occ = [], []
-        for _ in range(args.repeat):
+        for _ in range(repeat):
             ours.append(time_ours(records, ours_path))
             if faces is not None:
                 occ.append(time_occ(faces, occ_path))
         size_ours = os.path.getsize(ours_path)
         size_occ = os.path.getsize(occ_path) if faces is not None else 0
     m_ours = statistics.median(ours)
+    m_occ = statistics.median(occ) if faces is not None else float("nan")
+    return {"ours": m_ours, "occ": m_occ, "ratio": m_ours / m_occ, "size_ours": size_ours, "size_occ": size_occ}
+
+
+def figures() -> list[dict]:
+    r = measure()
+    baseline = (f"OCC IGESControl_Writer {r['occ']:.2f} s, same run (ours {r['ours']:.2f} s)"
+                if r["occ"] == r["occ"] else "OCP not installed: no OCC baseline")
+    return [{"figure": "IGES write vs OCC, 100 surfaces of 40x40", "value": r["ratio"], "unit": "x",
+             "baseline": baseline, "goal": f"<= {GOAL_RATIO}x"}]
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--surfaces", type=int, default=100)
+    ap.add_argument("--size", type=int, default=40)
+    args = ap.parse_args([] if argv is None else argv)
+    r = measure(args.repeat, args.surfaces, args.size)
     print(f"bladesmith.iges write_iges: {args.surfaces} bicubic surfaces of {args.size}x{args.size} "
-          f"control points: median {m_ours:.3f} s over {args.repeat} runs ({size_ours / 1e6:.1f} MB)")
-    if faces is not None:
-        m_occ = statistics.median(occ)
-        print(f"OpenCASCADE IGESControl_Writer (faces of Geom_BSplineSurface): median {m_occ:.3f} s "
-              f"({size_occ / 1e6:.1f} MB)")
-        print(f"ratio bladesmith / OCC: {m_ours / m_occ:.2f}")
+          f"control points: median {r['ours']:.3f} s over {args.repeat} runs ({r['size_ours'] / 1e6:.1f} MB)")
+    if r["occ"] == r["occ"]:
+        print(f"OpenCASCADE IGESControl_Writer (faces of Geom_BSplineSurface): median {r['occ']:.3f} s "
+              f"({r['size_occ'] / 1e6:.1f} MB)")
+        print(f"ratio bladesmith / OCC: {r['ratio']:.2f} (goal <= {GOAL_RATIO})")
     else:
         print("OCP not installed: no OpenCASCADE baseline")
     return 0

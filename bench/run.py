@@ -16,7 +16,11 @@ def main(selected: list[str]) -> None:
         name = path.stem
         if selected and not any(s in name for s in selected):
             continue
-        importlib.import_module(name).main()
+        saved, sys.argv = sys.argv, [sys.argv[0]]  # modules that parse sys.argv see no options
+        try:
+            importlib.import_module(name).main()
+        finally:
+            sys.argv = saved
 
 
 if __name__ == "__main__":

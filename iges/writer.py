@@ -86,15 +86,115 @@ def _reals(values) -> str:
         for i in np.flatnonzero((mag != 0) & ((mag < 1e-4) | (mag >= 1e16))).tolist():
             strs[i] = format_real(a[i])
         return ",".join(strs)
-    # Bulk data: 17 significant digits (max_digits10, exact for every double) in one
-    # C-level format call; the few integral or exponent-form values are written by
-    # format_real so that every real keeps its decimal point.
-    fmt = ["%.17g"] * a.size
-    args = a.tolist()
-    for i in np.flatnonzero((a == np.trunc(a)) | (mag < 1e-4) | (mag >= 1e17)).tolist():
-        fmt[i] = "%s"
-        args[i] = format_real(args[i])
-    return ",".join(fmt) % tuple(args)
+    # Bulk data: 17 significant digits (max_digits10, exact for every double), the text
+    # of "%.17g" built by numpy (_bulk_reals); the few integral or exponent-form values
+    # are written by format_real so that every real keeps its decimal point.
+    return ",".join(_bulk_reals(a[s : s + BULK_CHUNK]) for s in range(0, a.size, BULK_CHUNK))
+
+
+# -- bulk reals: "%.17g" by array arithmetic --------------------------------------------------
+#: Reals formatted per numpy pass: keeps the (chunk, 24) byte temporaries in cache.
+BULK_CHUNK = 1 << 13
+#: 10**k for k = 0..22, all exact doubles.
+_POW10 = 10.0 ** np.arange(23)
+#: Veltkamp's splitting constant 2**27 + 1: exact products without a fused multiply-add.
+_SPLIT = 134217729.0
+#: The characters of 0000 .. 9999 as little-endian 4-byte words (first character lowest).
+_FOUR_DIGITS = np.frombuffer("".join(f"{i:04d}" for i in range(10**4)).encode("ascii"), dtype="<u4")
+#: Trailing zero digits of 0000 .. 9999 (4 for 0000).
+_TRAILING_ZEROS = np.array([len(f"{i:04d}") - len(f"{i:04d}".rstrip("0")) for i in range(10**4)], dtype=np.int64)
+#: Word masks keeping the first 4, 3, 2, 1, 0 characters.
+_KEEP_MASK = np.array([0xFFFFFFFF, 0x00FFFFFF, 0x0000FFFF, 0x000000FF, 0], dtype="<u4")
+_COMMA, _DOT, _ZERO, _MINUS, _HOLE = (ord(c) for c in ",.0-#")
+
+
+def _scaled_integers(m: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """round(m * 10**t) exactly (ties to even), for 10**16 <= m * 10**t < 2**63: the
+    product as hi + lo by Dekker's TwoProduct (hi >= 2**53 is an even integer, so
+    rounding lo to even rounds the sum to even)."""
+    pw = _POW10[t]
+    hi = m * pw
+    s = _SPLIT * m
+    mh = s - (s - m)
+    ml = m - mh
+    s = _SPLIT * pw
+    ph = s - (s - pw)
+    pl = pw - ph
+    lo = ((mh * ph - hi) + mh * pl + ml * ph) + ml * pl
+    return hi.astype(np.int64) + np.rint(lo).astype(np.int64)
+
+
+def _bulk_reals(a: np.ndarray) -> str:
+    """``",".join("%.17g" % x ...)`` for reals with 1e-4 <= |x| < 1e17 and a fraction
+    (byte-identical to C's printf, which rounds the exact binary value to 17 significant
+    digits, half to even), and :func:`format_real` for the others.
+
+    |x| = D · 10**-t with D the 17-digit integer nearest to |x| · 10**t, computed exactly
+    (:func:`_scaled_integers`); "%g" then writes D's digits with the point after digit
+    16 - t (or "0.000" before them) and drops trailing zeros of the fraction."""
+    values = a
+    m = np.abs(a)
+    bulk = (m >= 1e-4) & (m < 1e17) & (a != np.trunc(a))
+    special = None if bulk.all() else np.flatnonzero(~bulk)
+    if special is not None:
+        keep = np.flatnonzero(bulk)
+        a, m = a[keep], m[keep]
+    t = 16 - np.floor(np.log10(m)).astype(np.intp)
+    D = _scaled_integers(m, t)
+    for _ in range(2):  # log10 may be one off next to a power of ten
+        wrong = np.flatnonzero((D >= 10**17) | (D < 10**16))
+        if not wrong.size:
+            break
+        t[wrong] += np.where(D[wrong] < 10**16, 1, -1)
+        D[wrong] = _scaled_integers(m[wrong], t[wrong])
+    # the 17 digits as five little-endian 4-byte words: the leading digit in the last byte
+    # of the first word, then four groups of four looked up in a table of "0000".."9999";
+    # trailing zeros of the fraction are dropped (as "%g" drops them) by zeroing their
+    # bytes (the fraction is never all zero)
+    words = np.empty((D.size, 5), dtype="<u4")
+    rest = D
+    trailing = np.zeros(D.size, dtype=np.int64)
+    all_zero = np.ones(D.size, dtype=bool)
+    for col in (4, 3, 2, 1):
+        group = rest % 10**4
+        rest = rest // 10**4
+        words[:, col] = np.take(_FOUR_DIGITS, group)
+        trailing += np.where(all_zero, np.take(_TRAILING_ZEROS, group), 0)
+        all_zero &= group == 0
+    words[:, 0] = (_ZERO + rest.astype("<u4")) << 24
+    for col in (4, 3, 2, 1):  # zeros dropped from this word: min(4, max(0, trailing - 4 (4 - col)))
+        drop = np.clip(trailing - 4 * (4 - col), 0, 4)
+        words[:, col] &= np.take(_KEEP_MASK, drop)
+    digits = words.view(np.uint8)[:, 3:]  # (n, 17)
+    rows = np.zeros((D.size, 24), dtype=np.uint8)  # sign, up to 22 characters, comma
+    rows[:, 0] = np.where(a < 0, _MINUS, 0)
+    rows[:, 23] = _COMMA
+    X = 16 - t  # the decimal exponent, -4 <= X <= 16
+    for e in np.unique(X).tolist():
+        idx = np.flatnonzero(X == e)
+        d = digits[idx]
+        if e >= 0:
+            block = np.empty((idx.size, 18), dtype=np.uint8)
+            block[:, : e + 1] = d[:, : e + 1]
+            block[:, e + 1] = _DOT
+            block[:, e + 2 :] = d[:, e + 1 :]
+        else:
+            block = np.full((idx.size, 18 - e), _ZERO, dtype=np.uint8)  # "0." and -e - 1 zeros
+            block[:, 1] = _DOT
+            block[:, 1 - e :] = d
+        rows[idx, 1 : 1 + block.shape[1]] = block
+    if special is not None:
+        full = np.zeros((bulk.size, 24), dtype=np.uint8)
+        full[keep] = rows
+        full[special, 0] = _HOLE
+        full[special, 23] = _COMMA
+        rows = full
+    flat = rows.ravel()
+    text = flat[flat != 0].tobytes().decode("ascii")[:-1]
+    if special is None:
+        return text
+    others = [format_real(x) for x in values[special].tolist()] + [""]
+    return "".join(chain.from_iterable(zip(text.split(chr(_HOLE)), others)))
 
 
 def hollerith(text: str) -> str:

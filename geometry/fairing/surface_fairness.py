@@ -115,18 +115,28 @@ def principal_curvatures(surface: BSplineSurface, u, v) -> dict:
 
 def surface_fairness(surface: BSplineSurface, quadrature_points: int | None = None) -> Fairness:
     """MVS and strain energy (Hosseini 2016 Eq. 6) of ``surface`` by Gauss–Legendre
-    quadrature per knot span (``quadrature_points`` nodes per span and direction)."""
+    quadrature per knot span (``quadrature_points`` nodes per span and direction).
+
+    The integrands come from :func:`.surface_curvature.surface_curvature_grid`, the same
+    formulas as :func:`principal_curvatures` with the 2x2 pencil solved in closed form
+    (at an umbilic it takes e1 along S_u, exact where II = κ I in a neighbourhood)."""
     if not isinstance(surface, BSplineSurface):
         raise GeometryError(f"surface_fairness needs a BSplineSurface, got {type(surface).__name__}")
     g = DEFAULT_QUADRATURE_POINTS if quadrature_points is None else int(quadrature_points)
     if g < 1:
         raise GeometryError(f"quadrature_points must be >= 1, got {quadrature_points!r}")
+    if surface.dim != 3:
+        raise GeometryError(f"fairness needs a 3-D surface, got dim {surface.dim}")
+    from .surface_curvature import surface_curvature_grid
+
     us, wu = _gauss_nodes(surface.knots_u, g)
     vs, wv = _gauss_nodes(surface.knots_v, g)
-    c = principal_curvatures(surface, us[:, None], vs[None, :])
-    W = wu[:, None] * wv[None, :] * c["dA"]
-    mvs = float(np.sum(W * (c["dk1_de1"] ** 2 + c["dk2_de2"] ** 2)))
-    se = float(np.sum(W * (c["k1"] ** 2 + c["k2"] ** 2)))
+    # The nodes form a tensor grid: derivatives by one matrix product per (k, l) and the
+    # 2x2 eigenproblems in closed form (surface_curvature), not per point through LAPACK.
+    c = surface_curvature_grid(surface, us, vs, fairness=True)
+    W = wu[:, None] * wv[None, :] * c.area_element
+    mvs = float(np.sum(W * c.mvs_density))
+    se = float(np.sum(W * c.strain_energy_density))
     return Fairness(mvs, se, float(W.sum()))
 
 

@@ -40,6 +40,10 @@ from .curve import BSplineCurve, validate_points, validate_weights
 #: Parameter pairs evaluated per chunk: bounds the temporary (chunk, p+1, q+1, dim) gather
 #: and keeps it in cache.
 EVAL_CHUNK = 1 << 13
+#: Span lookup of the table path: uniform bins per knot of the vector (see _SpanLookup),
+#: at most SPAN_BINS_MAX bins.
+SPAN_BINS_PER_KNOT = 16
+SPAN_BINS_MAX = 1 << 16
 #: The patch table is used when there are at least this many points per patch...
 TABLE_MIN_POINTS_PER_PATCH = 4
 #: ...and the table is no larger than this many bytes.
@@ -173,10 +177,18 @@ class BSplineSurface:
         mid_u, Tu = _taylor_matrices(self.knots_u, p, nu)
         mid_v, Tv = _taylor_matrices(self.knots_v, q, nv)
         windows = np.lib.stride_tricks.sliding_window_view(net, (p + 1, q + 1), axis=(0, 1))
-        table = np.einsum("iac,jbd,ijecd->ijabe", Tu, Tv, windows, optimize=True)
-        table = np.ascontiguousarray(table.reshape(Tu.shape[0] * Tv.shape[0], (p + 1) * (q + 1), -1))
+        # v power first: table[patch, b, a, :] multiplies (v - m_v)^b (u - m_u)^a, so that a
+        # pair's gathered (q+1, (p+1) dim') block is contracted with the v monomials by one
+        # batched product and the (p+1, dim') result with the u monomials, with no
+        # (n, (p+1)(q+1)) outer product of the monomials
+        table = np.einsum("iac,jbd,ijecd->ijbae", Tu, Tv, windows, optimize=True)
+        table = np.ascontiguousarray(table.reshape(Tu.shape[0] * Tv.shape[0], q + 1, (p + 1) * net.shape[2]))
         table.flags.writeable = False
         return mid_u, mid_v, table
+
+    @cached_property
+    def _span_lookups(self):
+        return _SpanLookup(self.knots_u, self.degree_u), _SpanLookup(self.knots_v, self.degree_v)
 
     def _use_patch_table(self, n_points: int) -> bool:
         p, q = self.degree_u, self.degree_v
@@ -187,19 +199,21 @@ class BSplineSurface:
     def _table_derivatives(self, u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
         p, q = self.degree_u, self.degree_v
         mid_u, mid_v, table = self._patch_table
+        span_u, span_v = self._span_lookups
         n_spans_v = mid_v.size
-        out = np.zeros((u.size, order + 1, order + 1, table.shape[2]))
+        dim = table.shape[2] // (p + 1)
+        out = np.zeros((u.size, order + 1, order + 1, dim))
         for s in range(0, u.size, EVAL_CHUNK):
             uc, vc = u[s : s + EVAL_CHUNK], v[s : s + EVAL_CHUNK]
-            iu = find_span(self.knots_u, p, uc) - p
-            iv = find_span(self.knots_v, q, vc) - q
-            G = np.take(table, iu * n_spans_v + iv, axis=0)  # (n, (p+1)(q+1), dim')
+            iu = span_u(uc) - p
+            iv = span_v(vc) - q
+            G = np.take(table, iu * n_spans_v + iv, axis=0)  # (n, q+1, (p+1) dim')
             Mu = _monomial_derivatives(uc - mid_u[iu], p, order)
             Mv = _monomial_derivatives(vc - mid_v[iv], q, order)
-            for k in range(order + 1):
-                for l in range(order + 1 - k):
-                    W = (Mu[k][:, :, None] * Mv[l][:, None, :]).reshape(uc.size, 1, -1)
-                    out[s : s + EVAL_CHUNK, k, l] = np.matmul(W, G)[:, 0]
+            for l in range(order + 1):
+                row = np.einsum("nb,nbk->nk", Mv[l], G).reshape(uc.size, p + 1, dim)
+                for k in range(order + 1 - l):
+                    out[s : s + EVAL_CHUNK, k, l] = np.einsum("na,nad->nd", Mu[k], row)
         return out
 
     def _homogeneous_derivatives(self, u: np.ndarray, v: np.ndarray, order: int) -> np.ndarray:
@@ -323,3 +337,54 @@ def _collocation(knots: np.ndarray, degree: int, n_control: int, params: np.ndar
     rows = np.arange(params.size)[:, None]
     M[rows, span[:, None] - degree + np.arange(degree + 1)] = N
     return M
+
+
+class _SpanLookup:
+    """find_span (NURBS Book Alg. A2.1) for many parameters through a table of uniform
+    bins: bin j starts from the span of the start of bin j - 1 (safe against rounding of
+    the bin index), and each parameter steps up while U[span + 1] <= u. When the bins are
+    fine enough that no two distinct knots lie within two neighbouring bins (up to
+    :data:`SPAN_BINS_MAX` bins), one step decides: span = the stepped span of the bin
+    where u >= its next knot. The result is exactly that of :func:`.basis.find_span` for
+    parameters in the domain; a binary search per parameter (``searchsorted``) costs
+    several times more on scattered parameters."""
+
+    def __init__(self, knots: np.ndarray, degree: int):
+        a, b = domain_of(knots, degree)
+        inner = np.unique(knots[(knots >= a) & (knots <= b)])
+        n_bins = SPAN_BINS_PER_KNOT * len(knots)
+        gap = float(np.min(np.diff(inner))) if inner.size > 1 else b - a
+        # three bins per smallest gap: a window of two bins then holds at most one knot
+        fine = int(np.ceil(3.0 * (b - a) / gap)) if gap > 0 else SPAN_BINS_MAX + 1
+        self.one_step = fine <= SPAN_BINS_MAX
+        if self.one_step:
+            n_bins = max(n_bins, fine)
+        n_bins = int(min(SPAN_BINS_MAX, n_bins))
+        width = (b - a) / n_bins
+        self.knots = knots
+        self.start = a
+        self.scale = 1.0 / width
+        self.n_bins = n_bins
+        edges = a + width * np.arange(-1, n_bins - 1)
+        edges[0] = a
+        self.first = find_span(knots, degree, np.clip(edges, a, b))
+        self.last = int(find_span(knots, degree, np.array([b]))[0])
+        if self.one_step:
+            # the next knot above each bin's first span, and the span that starts there
+            top = np.minimum(self.first + 1, len(knots) - 1)
+            self.next_knot = np.where(self.first < self.last, knots[top], np.inf)
+            self.stepped = find_span(knots, degree, np.clip(np.minimum(self.next_knot, b), a, b))
+
+    def __call__(self, u: np.ndarray) -> np.ndarray:
+        j = ((u - self.start) * self.scale).astype(np.intp)
+        np.clip(j, 0, self.n_bins - 1, out=j)
+        if self.one_step:
+            return np.where(u >= self.next_knot[j], self.stepped[j], self.first[j])
+        span = self.first[j]
+        knots, last = self.knots, self.last
+        while True:
+            step = knots[span + 1] <= u
+            step &= span < last
+            if not step.any():
+                return span
+            span += step
