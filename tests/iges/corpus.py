@@ -37,12 +37,15 @@ def _download(source: dict, dest: pathlib.Path) -> pathlib.Path:
     dest.mkdir(parents=True, exist_ok=True)
     name, version = source["package"], source["version"]
     if source["client"] == "pip":
-        found = list(dest.glob(f"{name}-{version}.tar.gz"))
+        # sdists name their archive after the normalised project name (pyvista-cad ->
+        # pyvista_cad-0.0.5.tar.gz)
+        archive = source.get("archive", f"{name}-{version}.tar.gz")
+        found = list(dest.glob(archive))
         if not found:
             cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary", ":all:",
                    f"{name}=={version}", "-d", str(dest)]
             r = subprocess.run(cmd, capture_output=True, text=True)
-            found = list(dest.glob(f"{name}-{version}.tar.gz"))
+            found = list(dest.glob(archive))
             if r.returncode or not found:
                 raise CorpusUnavailable(f"pip download {name}=={version} failed: {r.stderr[-300:]}")
         return found[0]
