@@ -694,7 +694,10 @@ def import_model(model: IgesModel, file_bytes: int, tolerance: float = DISPLAY_T
     imp = _Importer(model, budget, tolerance)
     place = Placement(factor=units.factor)
     roots = model.roots
-    if model.dependent and not model.skipped and not any(_type_of(r) not in NO_GEOMETRY_TYPES for r in roots):
+    from .foreign import Group402
+
+    if model.dependent and not model.skipped and not any(
+            isinstance(r, Group402) or _type_of(r) not in NO_GEOMETRY_TYPES for r in roots):
         # every unreferenced entity is flagged dependent (DE status): the flags are wrong,
         # so go by references alone, as OpenCASCADE does
         roots = replace(model, dependent=frozenset()).roots
