@@ -239,7 +239,8 @@ class _Rows:
         return (self[k] for k in range(len(self)))
 
     def columns(self, c0: int, c1: int) -> np.ndarray:
-        return self.a[self.lo : self.hi, c0:c1]
+        # contiguous first: tobytes() of a strided view is many times slower than a copy
+        return np.ascontiguousarray(self.a[self.lo : self.hi, c0:c1])
 
 
 def _fixed_array(data) -> np.ndarray | None:
@@ -258,7 +259,9 @@ def _fixed_array(data) -> np.ndarray | None:
         if len(b) < w or len(b) % w:
             continue
         a = np.frombuffer(b, dtype=np.uint8).reshape(-1, w)
-        if np.all(a[:, 80:] == np.frombuffer(eol, dtype=np.uint8)) and not np.any((a[:, :80] == 10) | (a[:, :80] == 13)):
+        # every line ends with ``eol`` and no other CR or LF is in the file
+        if (np.all(a[:, 80:] == np.frombuffer(eol, dtype=np.uint8))
+                and b.count(b"\n") == len(a) and b.count(b"\r") == len(a) * (len(eol) - 1)):
             return a[:, :80]
     return None
 
@@ -315,15 +318,15 @@ def _sections_fast(lines):
 def _column_integers(f: np.ndarray) -> np.ndarray | None:
     """Right-justified unsigned integers in columns of a uint8 array (one per row, leading
     blanks, at least the last column a digit); None when any row is not such a number."""
-    f = f.astype(np.int64)
-    digit = (f >= 48) & (f <= 57)
-    space = f == 32
-    if not np.all(digit | space) or not np.all(digit[:, -1]):
+    d = f - np.uint8(48)  # digits 0..9; a blank wraps to 240
+    digit = d <= 9
+    if not np.all(digit | (f == 32)) or not np.all(digit[:, -1]):
         return None
-    # spaces may only lead: once a digit is seen, no space follows
-    if np.any(space[:, 1:] & np.maximum.accumulate(digit, axis=1)[:, :-1]):
+    # blanks may only lead: once a digit is seen, no blank follows
+    if np.any(~digit[:, 1:] & np.maximum.accumulate(digit, axis=1)[:, :-1]):
         return None
-    return (np.where(digit, f - 48, 0) * (10 ** np.arange(f.shape[1] - 1, -1, -1))).sum(axis=1)
+    d[~digit] = 0
+    return d.astype(np.int64) @ (10 ** np.arange(f.shape[1] - 1, -1, -1, dtype=np.int64))
 
 
 # -- parameters ----------------------------------------------------------------------------------
