@@ -745,13 +745,18 @@ def _loops_143(imp, record: BoundedSurface143):
     return _order_loops(loops)
 
 
+def _model_to_uv_points(surface: AnalyticSurface, X: np.ndarray) -> np.ndarray:
+    """(u, v) of model points on an analytic surface (its own 124 undone)."""
+    if surface.transform is not None:
+        A, b = _chain_matrix_of(surface)
+        X = np.linalg.solve(A, (X - b).T).T
+    return analytic_uv(surface, X)
+
+
 def _model_to_uv(imp, surface, curve) -> np.ndarray:
     X = np.concatenate(list(imp._model_points(curve)))
     if isinstance(surface, AnalyticSurface):
-        if surface.transform is not None:
-            A, b = _chain_matrix_of(surface)
-            X = np.linalg.solve(A, (X - b).T).T
-        return analytic_uv(surface, X)
+        return _model_to_uv_points(surface, X)
     if isinstance(surface, Plane108):
         return plane_uv(surface, X)
     if isinstance(surface, BSplineSurface128) and surface.transform is None:

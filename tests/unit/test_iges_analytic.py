@@ -72,3 +72,27 @@ def test_a_loop_over_the_pole_keeps_its_area():
     flat = unwrap_loop(s, uv, {})
     x, y = flat[:, 0], flat[:, 1]
     assert abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))) / 2 < 1e-9
+
+
+def test_trimmed_cylinder_face_from_model_space_loop(tmp_path):
+    import importlib.util
+    import pathlib
+
+    from bladesmith.iges.importer import import_path
+
+    spec = importlib.util.spec_from_file_location("import_cases", pathlib.Path(__file__).with_name("import_cases.py"))
+    C = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(C)
+    text, area = C.cylinder_face()
+    path = tmp_path / "cyl.igs"
+    path.write_text(text)
+    report = import_path(path)
+    assert report.counts == {"mesh": 1} and not report.skipped, (report.counts, report.skipped_summary())
+    m = report.items[0].mesh
+    V, T = m.vertices, m.triangles
+    got = 0.5 * np.linalg.norm(np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]]), axis=1).sum()
+    assert abs(got - area) <= 2e-3 * area, (got, area)
+    # on the cylinder of radius 2 about the transformed axis
+    R, t = C.rot([1.0, 2.0, 2.0], 0.6), np.array([1.0, -2.0, 0.5])
+    local = (V - t) @ R  # back to the cylinder's frame
+    assert np.abs(np.hypot(local[:, 0], local[:, 1]) - 2.0).max() <= 1e-9
