@@ -43,36 +43,55 @@ def occ_read(path):
     return reader.OneShape()
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--surfaces", type=int, default=100)
-    ap.add_argument("--size", type=int, default=40)
-    args = ap.parse_args(argv)
-
+def measure(repeat: int = 5, surfaces: int = 100, size: int = 40) -> dict:
+    """Medians in seconds: ``strict`` (read_iges), ``import`` (lenient parse + import_model),
+    ``occ`` (None without OCP), and the file's ``bytes``."""
     load_checkout()
     from bladesmith.iges import read_iges, surface_from_geometry, write_iges
     from bladesmith.iges.importer import import_model
     from bladesmith.iges.reader import parse_iges
 
-    records = [surface_from_geometry(s) for s in random_surfaces(args.surfaces, args.size)]
+    records = [surface_from_geometry(s) for s in random_surfaces(surfaces, size)]
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "bench.igs")
         write_iges(path, records, units="m")
-        size = os.path.getsize(path)
 
         def lenient():
             with open(path, "rb") as f:
                 data = f.read()
             return import_model(parse_iges(data, path=path, strict=False), len(data))
 
-        t_strict = time_call(lambda: read_iges(path), args.repeat)
-        t_import = time_call(lenient, args.repeat)
+        out = {"bytes": os.path.getsize(path), "strict": time_call(lambda: read_iges(path), repeat),
+               "import": time_call(lenient, repeat)}
         try:
-            t_occ = time_call(lambda: occ_read(path), args.repeat)
+            out["occ"] = time_call(lambda: occ_read(path), repeat)
         except ImportError:
-            t_occ = None
-    print(f"file: {args.surfaces} bicubic surfaces of {args.size}x{args.size} control points, {size / 1e6:.1f} MB")
+            out["occ"] = None
+    return out
+
+
+def figures() -> list[dict]:
+    """Rows of the ``make bench`` summary (bench/summary.py)."""
+    m = measure(repeat=3)
+    rows = [{"figure": "IGES read, 100 bicubic 40x40 surfaces (read_iges)", "value": 1e3 * m["strict"],
+             "unit": "ms", "baseline": "", "goal": ""}]
+    if m["occ"]:
+        rows.append({"figure": "IGES read / OCC IGESControl_Reader", "value": m["strict"] / m["occ"], "unit": "x",
+                     "baseline": f"OCC {1e3 * m['occ']:.0f} ms", "goal": "<= 1x"})
+        rows.append({"figure": "IGES import (lenient + import_model) / OCC", "value": m["import"] / m["occ"],
+                     "unit": "x", "baseline": f"OCC {1e3 * m['occ']:.0f} ms", "goal": "<= 1x"})
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--surfaces", type=int, default=100)
+    ap.add_argument("--size", type=int, default=40)
+    args = ap.parse_args(argv)
+    m = measure(args.repeat, args.surfaces, args.size)
+    t_strict, t_import, t_occ = m["strict"], m["import"], m["occ"]
+    print(f"file: {args.surfaces} bicubic surfaces of {args.size}x{args.size} control points, {m['bytes'] / 1e6:.1f} MB")
     print(f"bladesmith read_iges (strict parse): median {t_strict:.3f} s over {args.repeat} runs")
     print(f"bladesmith lenient parse + import_model: median {t_import:.3f} s")
     if t_occ is not None:
