@@ -790,7 +790,13 @@ def _face_loops(imp, face: Face510) -> list:
                 if ps:  # the sign of the parameter-space step across the pole
                     q = np.concatenate([np.concatenate(list(imp._param_points(c, 0)))[:, :2] for c in ps])
                     jumps[k] = float(q[-1, 0] - q[0, 0])
-        for e, ndx, same, ps in loop.edges:
+        # vertex edges (a pole or a degenerate side) with parameter curves: their uv
+        # steps are part of the loop in parameter space on other surfaces
+        steps = {} if analytic else {k: ps for k, _, ps in loop.vertex_edges if ps}
+        for j, (e, ndx, same, ps) in enumerate(loop.edges):
+            if j in steps:
+                pts.append(np.concatenate([np.concatenate(list(imp._param_points(q, 0)))[:, :2]
+                                           for q in steps.pop(j)]))
             if analytic:
                 # the model-space edge, whatever convention the writer used for its
                 # parameter-space curves (degrees or radians, swapped or shifted)
@@ -800,6 +806,8 @@ def _face_loops(imp, face: Face510) -> list:
             else:
                 seg = _model_to_uv(imp, face.surface, e.curves[ndx])
             pts.append(seg if same else seg[::-1])
+        for ps in steps.values():  # after the last edge
+            pts.append(np.concatenate([np.concatenate(list(imp._param_points(q, 0)))[:, :2] for q in ps]))
         loops.append(unwrap_loop(face.surface, pts, jumps) if analytic else np.concatenate(pts))
     return loops if face.outer_first else _order_loops(loops)
 
