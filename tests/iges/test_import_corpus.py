@@ -13,6 +13,9 @@ import sys
 
 HERE = pathlib.Path(__file__).resolve().parent
 SUITE_BYTES = 45_000
+#: Larger files in the suite for what only they show: shell1.brep.igs has a face whose
+#: loop steps along a degenerate side by a vertex edge (4 s).
+SUITE_EXTRA = {"shell1.brep.igs"}
 #: Bounding boxes of the trimmed faces' meshes agree with OCC's exact ones to this fraction of
 #: the model's diagonal (the meshes are within 1e-3 of each face's size).
 BBOX_TOL = 2e-3
@@ -36,7 +39,7 @@ def test_small_corpus_files_against_opencascade():
         # unreachable corpus is a failure, never a silent pass
         raise AssertionError(f"the public IGES corpus could not be fetched: {exc}") from None
     assert len(files) >= 60
-    small = [f for f in files if f.path.stat().st_size <= SUITE_BYTES]
+    small = [f for f in files if f.path.stat().st_size <= SUITE_BYTES or f.name in SUITE_EXTRA]
     rows = corpus.compare(small)
     print("\n" + corpus.table(rows))
     by_name = {r.name: r for r in rows}
@@ -56,3 +59,4 @@ def test_small_corpus_files_against_opencascade():
     # spheres crossed at their poles) come in whole
     assert any(n.endswith(".brep.igs") for n in by_name), sorted(by_name)
     assert by_name["fuse.brep.igs"].faces == by_name["fuse.brep.igs"].occ_faces == 10
+    assert by_name["shell1.brep.igs"].faces == by_name["shell1.brep.igs"].occ_faces == 99
