@@ -22,16 +22,6 @@ from bench_iges import random_surfaces
 from common import load_checkout
 
 
-def time_call(fn, repeat: int) -> float:
-    fn()  # warm-up (imports, caches)
-    out = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t)
-    return statistics.median(out)
-
-
 def occ_read(path):
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.IGESControl import IGESControl_Reader
@@ -43,41 +33,75 @@ def occ_read(path):
     return reader.OneShape()
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--surfaces", type=int, default=100)
-    ap.add_argument("--size", type=int, default=40)
-    args = ap.parse_args(argv)
-
+def measure(repeat: int = 5, surfaces: int = 100, size: int = 40) -> dict:
+    """Medians in seconds: ``strict`` (read_iges), ``import`` (lenient parse + import_model),
+    ``occ`` (None without OCP), and the file's ``bytes``."""
     load_checkout()
     from bladesmith.iges import read_iges, surface_from_geometry, write_iges
     from bladesmith.iges.importer import import_model
     from bladesmith.iges.reader import parse_iges
 
-    records = [surface_from_geometry(s) for s in random_surfaces(args.surfaces, args.size)]
+    records = [surface_from_geometry(s) for s in random_surfaces(surfaces, size)]
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "bench.igs")
         write_iges(path, records, units="m")
-        size = os.path.getsize(path)
 
         def lenient():
             with open(path, "rb") as f:
                 data = f.read()
             return import_model(parse_iges(data, path=path, strict=False), len(data))
 
-        t_strict = time_call(lambda: read_iges(path), args.repeat)
-        t_import = time_call(lenient, args.repeat)
+        calls = {"strict": lambda: read_iges(path), "import": lenient, "occ": lambda: occ_read(path)}
         try:
-            t_occ = time_call(lambda: occ_read(path), args.repeat)
+            import OCP  # noqa: F401
         except ImportError:
-            t_occ = None
-    print(f"file: {args.surfaces} bicubic surfaces of {args.size}x{args.size} control points, {size / 1e6:.1f} MB")
+            del calls["occ"]
+        # interleaved (strict, import, OCC, strict, ...) so that a change of load on a
+        # shared machine falls on all three alike; ratios are medians of per-round ratios
+        times = {k: [] for k in calls}
+        for fn in calls.values():
+            fn()  # warm-up (imports, caches)
+        for _ in range(repeat):
+            for k, fn in calls.items():
+                t = time.perf_counter()
+                fn()
+                times[k].append(time.perf_counter() - t)
+        out = {"bytes": os.path.getsize(path), "occ": None}
+        out.update({k: statistics.median(v) for k, v in times.items()})
+        if "occ" in times:
+            for k in ("strict", "import"):
+                out[f"{k}_ratio"] = statistics.median(a / b for a, b in zip(times[k], times["occ"]))
+    return out
+
+
+def figures() -> list[dict]:
+    """Rows of the ``make bench`` summary (bench/summary.py)."""
+    m = measure(repeat=3)
+    rows = [{"figure": "IGES read, 100 bicubic 40x40 surfaces (read_iges)", "value": 1e3 * m["strict"],
+             "unit": "ms", "baseline": "", "goal": ""}]
+    if m["occ"]:
+        rows.append({"figure": "IGES read / OCC IGESControl_Reader", "value": m["strict_ratio"], "unit": "x",
+                     "baseline": f"OCC {1e3 * m['occ']:.0f} ms", "goal": "<= 1x"})
+        rows.append({"figure": "IGES import (lenient + import_model) / OCC", "value": m["import_ratio"],
+                     "unit": "x", "baseline": f"OCC {1e3 * m['occ']:.0f} ms", "goal": "<= 1x"})
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--surfaces", type=int, default=100)
+    ap.add_argument("--size", type=int, default=40)
+    args = ap.parse_args(argv)
+    m = measure(args.repeat, args.surfaces, args.size)
+    t_strict, t_import, t_occ = m["strict"], m["import"], m["occ"]
+    print(f"file: {args.surfaces} bicubic surfaces of {args.size}x{args.size} control points, {m['bytes'] / 1e6:.1f} MB")
     print(f"bladesmith read_iges (strict parse): median {t_strict:.3f} s over {args.repeat} runs")
     print(f"bladesmith lenient parse + import_model: median {t_import:.3f} s")
     if t_occ is not None:
         print(f"OpenCASCADE IGESControl_Reader ReadFile + TransferRoots: median {t_occ:.3f} s")
-        print(f"ratio read_iges / OCC: {t_strict / t_occ:.2f}; ratio import / OCC: {t_import / t_occ:.2f}")
+        print(f"ratio read_iges / OCC: {m['strict_ratio']:.2f}; ratio import / OCC: {m['import_ratio']:.2f} "
+              "(medians of per-round ratios, interleaved)")
     return 0
 
 

@@ -7,7 +7,9 @@
 * 308 subfigure definition and 408 singular subfigure instance;
 * 402 groups (forms 1, 7, 14, 15) and 104 conic arcs;
 * 186 manifold solid B-rep with its 502/504/508/510/514 topology: each face is imported
-  as a trimmed face. Faces on the analytic surfaces 190-198 are not read yet.
+  as a trimmed face, also on the analytic surfaces 190-198 (:mod:`.analytic`), whose
+  loops are mapped from the edges' model-space curves by the surfaces' closed-form
+  inverses.
 
 Also the lenient builders the reader uses with ``strict=False`` (:data:`LENIENT_BUILDERS`)
 and their structure checks (:func:`check_lenient`), which accept these surfaces under
@@ -46,6 +48,7 @@ from .records import (
     TransformationMatrix,
     TrimmedSurface,
 )
+from .analytic import AnalyticSurface, analytic_points, analytic_uv, lenient_builders as _analytic_builders, unwrap_loop
 from .validate import check_structure
 
 #: Coincident control points across a knot of multiplicity degree + 1 (a C0 curve written
@@ -166,9 +169,10 @@ class VertexList502(Entity):
 class EdgeList504(Entity):
     type_number: ClassVar[int] = 504
     curves: tuple = ()
+    vertex_lists: tuple = ()
 
     def references(self):
-        return self.curves
+        return self.curves + self.vertex_lists
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,11 +181,17 @@ class Loop508(Entity):
 
     type_number: ClassVar[int] = 508
     edges: tuple = ()  # (edge list 504, 0-based index, same sense?, tuple of parameter curves)
+    # vertex "edges" (TYPE 1, a pole or apex): (number of edges before it, its vertex list,
+    # its parameter curves), which say how a loop crosses a pole in parameter space
+    vertex_edges: tuple = ()
 
     def references(self):
         out = []
         for e, _, _, ps in self.edges:
             out.append(e)
+            out.extend(ps)
+        for _, v, ps in self.vertex_edges:
+            out.append(v)
             out.extend(ps)
         return tuple(out)
 
@@ -253,7 +263,7 @@ FOREIGN_TYPES = (Group402, Conic104, Plane108, TabulatedCylinder122, OffsetSurfa
                  SubfigureDefinition308, SubfigureInstance408, Solid186, Shell514, Face510, Loop508,
                  EdgeList504, VertexList502)
 #: Surfaces accepted under 142, 144 and 143 when reading leniently.
-LENIENT_SURFACES = SURFACE_TYPES + (Plane108, TabulatedCylinder122, OffsetSurface140)
+LENIENT_SURFACES = SURFACE_TYPES + (Plane108, TabulatedCylinder122, OffsetSurface140, AnalyticSurface)
 
 
 # -- lenient builders ----------------------------------------------------------------------
@@ -412,19 +422,23 @@ def _b502(p, r, form):
 
 def _b504(p, r, form):
     n = p.count("N (number of edges)", 5, lo=1)
-    curves = []
+    curves, lists = [], {}
     for k in range(n):
         curves.append(r(p.pointer(f"CURV({k + 1})"), "edge curve"))
-        p.pointer(f"SVP({k + 1})")
-        p.int(f"SV({k + 1})")
-        p.pointer(f"TVP({k + 1})")
-        p.int(f"TV({k + 1})")
-    return dict(curves=tuple(curves))
+        for what in ("SVP", "TVP"):
+            j = p.pointer(f"{what}({k + 1})")
+            if j not in lists:  # a vertex list is a child, not an independent entity
+                try:
+                    lists[j] = r(j, "vertex list")
+                except IgesError:
+                    lists[j] = None  # vertices are not used: a bad list is not fatal
+            p.int(f"{what[0]}V({k + 1})")
+    return dict(curves=tuple(curves), vertex_lists=tuple(v for v in lists.values() if v is not None))
 
 
 def _b508(p, r, form):
     n = p.count("N (number of edges)", 5, lo=1)
-    edges = []
+    edges, vertex_edges = [], []
     for k in range(n):
         kind = p.int(f"TYPE({k + 1})", lo=0, hi=1)
         e = r(p.pointer(f"EDGE({k + 1})"), "edge list")
@@ -437,7 +451,9 @@ def _b508(p, r, form):
             ps.append(r(p.pointer(f"CURV({k + 1}, {q + 1})"), "parameter curve"))
         if kind == 0:
             edges.append((e, ndx - 1, sense != 0, tuple(ps)))
-    return dict(edges=tuple(edges))
+        else:
+            vertex_edges.append((len(edges), e, tuple(ps)))
+    return dict(edges=tuple(edges), vertex_edges=tuple(vertex_edges))
 
 
 def _b510(p, r, form):
@@ -500,7 +516,7 @@ def _lenient_builders():
         141: (Boundary141, _b141), 143: (BoundedSurface143, _b143), 308: (SubfigureDefinition308, _b308),
         408: (SubfigureInstance408, _b408), 502: (VertexList502, _b502), 504: (EdgeList504, _b504),
         508: (Loop508, _b508), 510: (Face510, _b510), 514: (Shell514, _b514), 186: (Solid186, _b186),
-        402: (Group402, _b402), 104: (Conic104, _b104),
+        402: (Group402, _b402), 104: (Conic104, _b104), **_analytic_builders(),
     }
 
 
@@ -530,6 +546,8 @@ def check_lenient(entity: Entity) -> None:
         _kind(entity, entity.surface, LENIENT_SURFACES, "surface")
         for c in ((entity.outer,) if entity.outer is not None else ()) + entity.inner:
             _kind(entity, c, (CurveOnSurface,), "boundary")
+    elif isinstance(entity, AnalyticSurface):
+        pass  # checked as it is built
     elif isinstance(entity, Plane108):
         a = entity.coefficients
         if not np.all(np.isfinite(a)) or not np.any(a[:3] != 0):
@@ -651,6 +669,14 @@ def surface_evaluator(surface: Entity):
             return _transform(surface, base(u, v) + surface.distance * N)
 
         return ev, (u0, u1), (v0, v1)
+    if isinstance(surface, AnalyticSurface):
+        def ev(u, v):
+            return _transform(surface, analytic_points(surface, u, v))
+
+        big = 1e300
+        t = surface.surface_type
+        # angles are unwrapped along the loops, so they may leave (-pi, pi]
+        return ev, (-big, big), ((-0.5 * math.pi, 0.5 * math.pi) if t == 196 else (-big, big))
     if isinstance(surface, Plane108):
         origin, e1, e2, _ = _plane_frame(surface)
 
@@ -719,8 +745,18 @@ def _loops_143(imp, record: BoundedSurface143):
     return _order_loops(loops)
 
 
+def _model_to_uv_points(surface: AnalyticSurface, X: np.ndarray) -> np.ndarray:
+    """(u, v) of model points on an analytic surface (its own 124 undone)."""
+    if surface.transform is not None:
+        A, b = _chain_matrix_of(surface)
+        X = np.linalg.solve(A, (X - b).T).T
+    return analytic_uv(surface, X)
+
+
 def _model_to_uv(imp, surface, curve) -> np.ndarray:
     X = np.concatenate(list(imp._model_points(curve)))
+    if isinstance(surface, AnalyticSurface):
+        return _model_to_uv_points(surface, X)
     if isinstance(surface, Plane108):
         return plane_uv(surface, X)
     if isinstance(surface, BSplineSurface128) and surface.transform is None:
@@ -745,15 +781,34 @@ def _order_loops(loops: list) -> list:
 
 def _face_loops(imp, face: Face510) -> list:
     loops = []
+    analytic = isinstance(face.surface, AnalyticSurface)
     for loop in face.loops:
         pts = []
-        for e, ndx, same, ps in loop.edges:
-            if ps:
+        jumps = {}
+        if analytic:
+            for k, _, ps in loop.vertex_edges:
+                if ps:  # the sign of the parameter-space step across the pole
+                    q = np.concatenate([np.concatenate(list(imp._param_points(c, 0)))[:, :2] for c in ps])
+                    jumps[k] = float(q[-1, 0] - q[0, 0])
+        # vertex edges (a pole or a degenerate side) with parameter curves: their uv
+        # steps are part of the loop in parameter space on other surfaces
+        steps = {} if analytic else {k: ps for k, _, ps in loop.vertex_edges if ps}
+        for j, (e, ndx, same, ps) in enumerate(loop.edges):
+            if j in steps:
+                pts.append(np.concatenate([np.concatenate(list(imp._param_points(q, 0)))[:, :2]
+                                           for q in steps.pop(j)]))
+            if analytic:
+                # the model-space edge, whatever convention the writer used for its
+                # parameter-space curves (degrees or radians, swapped or shifted)
+                seg = _model_to_uv(imp, face.surface, e.curves[ndx])
+            elif ps:
                 seg = np.concatenate([np.concatenate(list(imp._param_points(q, 0)))[:, :2] for q in ps])
             else:
                 seg = _model_to_uv(imp, face.surface, e.curves[ndx])
             pts.append(seg if same else seg[::-1])
-        loops.append(np.concatenate(pts))
+        for ps in steps.values():  # after the last edge
+            pts.append(np.concatenate([np.concatenate(list(imp._param_points(q, 0)))[:, :2] for q in ps]))
+        loops.append(unwrap_loop(face.surface, pts, jumps) if analytic else np.concatenate(pts))
     return loops if face.outer_first else _order_loops(loops)
 
 

@@ -373,7 +373,16 @@ class _Importer:
         surface: planes and untransformed 128 surfaces)."""
         from . import foreign
 
-        if cos.parameter_curve is not None and not isinstance(cos.surface, foreign.Plane108):
+        if isinstance(cos.surface, foreign.AnalyticSurface):
+            # writers differ on the units of parameter curves over 190-198 (degrees or
+            # radians, shifted, swapped): the model-space curve, mapped by the surface's
+            # closed-form inverse, is unambiguous
+            if cos.model_curve is None:
+                raise IgesError(f"{cos.describe()}: a boundary on an analytic surface (type "
+                                f"{cos.surface.surface_type}) without a model-space curve")
+            edges = [foreign._model_to_uv_points(cos.surface, _pad3(X)) for X in self._model_points(cos.model_curve)]
+            P = foreign.unwrap_loop(cos.surface, edges)
+        elif cos.parameter_curve is not None and not isinstance(cos.surface, foreign.Plane108):
             P = np.concatenate(list(self._param_points(cos.parameter_curve, 0)))[:, :2]
         elif cos.model_curve is not None:
             P = foreign._model_to_uv(self, cos.surface, cos.model_curve)
@@ -446,6 +455,12 @@ class _Importer:
             if isinstance(surf, foreign.Plane108):
                 raise IgesError(f"{record.describe()}: a plane with no outer boundary is unbounded")
             _, (u0, u1), (v0, v1) = foreign.surface_evaluator(surf)
+            if isinstance(surf, foreign.AnalyticSurface):
+                if surf.surface_type not in (196, 198):
+                    raise IgesError(f"{record.describe()}: an analytic surface of type {surf.surface_type} "
+                                    "with no outer boundary is unbounded")
+                # the whole sphere or torus
+                (u0, u1), (v0, v1) = (-math.pi, math.pi), ((v0, v1) if surf.surface_type == 196 else (-math.pi, math.pi))
             outer = np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]])
         else:
             outer = self.loop_polyline(record.outer)
@@ -694,7 +709,10 @@ def import_model(model: IgesModel, file_bytes: int, tolerance: float = DISPLAY_T
     imp = _Importer(model, budget, tolerance)
     place = Placement(factor=units.factor)
     roots = model.roots
-    if model.dependent and not model.skipped and not any(_type_of(r) not in NO_GEOMETRY_TYPES for r in roots):
+    from .foreign import Group402
+
+    if model.dependent and not model.skipped and not any(
+            isinstance(r, Group402) or _type_of(r) not in NO_GEOMETRY_TYPES for r in roots):
         # every unreferenced entity is flagged dependent (DE status): the flags are wrong,
         # so go by references alone, as OpenCASCADE does
         roots = replace(model, dependent=frozenset()).roots

@@ -48,9 +48,9 @@ SECTIONS = "SGDPT"
 _INT = re.compile(r"[+-]?[0-9]{1,12}")
 _DIGITS = re.compile(r"[0-9]{1,12}")
 _REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
+#: The characters an IGES real is written with (and the parameter delimiter between them).
+_REAL_CHARS = b"0123456789+-.EeDd, "
 _HOLLERITH = re.compile(r" *([0-9]{1,9})H")
-_REALS = re.compile(r"(?:[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?,)*"
-                    r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
 
 
 class _Str(str):
@@ -216,32 +216,84 @@ def _sections(lines: list[str], src: _Source, lenient: bool = False, notes: list
     return sec
 
 
-def _sections_fast(lines: list[str]):
+class _Rows:
+    """Lines lo..hi-1 of a fixed 80-column file held as a (n, 80) uint8 array, as the
+    (line number, text) pairs :func:`_sections` gives, decoded only when asked for."""
+
+    def __init__(self, a: np.ndarray, lo: int, hi: int):
+        self.a, self.lo, self.hi = a, lo, hi
+
+    def __len__(self):
+        return self.hi - self.lo
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return [self[j] for j in range(*k.indices(len(self)))]
+        if k < 0:
+            k += len(self)
+        if not 0 <= k < len(self):
+            raise IndexError(k)
+        return self.lo + k + 1, self.a[self.lo + k].tobytes().decode("latin-1")
+
+    def __iter__(self):
+        return (self[k] for k in range(len(self)))
+
+    def columns(self, c0: int, c1: int) -> np.ndarray:
+        # contiguous first: tobytes() of a strided view is many times slower than a copy
+        return np.ascontiguousarray(self.a[self.lo : self.hi, c0:c1])
+
+
+def _fixed_array(data) -> np.ndarray | None:
+    """The (n, 80) uint8 array of a file of n lines of exactly 80 columns, each ended by
+    one line feed or CR LF (the last one optionally), or None."""
+    if isinstance(data, str):
+        try:
+            data = data.encode("latin-1")
+        except UnicodeEncodeError:
+            return None
+    b = bytes(data)
+    for eol in (b"\n", b"\r\n"):
+        w = 80 + len(eol)
+        if len(b) % w == 80:
+            b = b + eol
+        if len(b) < w or len(b) % w:
+            continue
+        a = np.frombuffer(b, dtype=np.uint8).reshape(-1, w)
+        # every line ends with ``eol`` and no other CR or LF is in the file
+        if (np.all(a[:, 80:] == np.frombuffer(eol, dtype=np.uint8))
+                and b.count(b"\n") == len(a) and b.count(b"\r") == len(a) * (len(eol) - 1)):
+            return a[:, :80]
+    return None
+
+
+def _sections_fast(lines):
     """:func:`_sections` for a well-formed file, vectorised (numpy over the 80-column
-    records); None whenever anything is unusual, and the line-by-line check then says what."""
-    n = len(lines)
-    if n < 2 or set(map(len, lines)) != {80}:
-        return None
-    try:
-        flat = "".join(lines).encode("latin-1")
-    except UnicodeEncodeError:
-        return None
-    a = np.frombuffer(flat, dtype=np.uint8).reshape(n, 80)
+    records); None whenever anything is unusual, and the line-by-line check then says what.
+    ``lines``: a list of lines, or the (n, 80) uint8 array of :func:`_fixed_array` (then
+    the Parameter Data section is a lazy :class:`_Rows`)."""
+    if isinstance(lines, np.ndarray):
+        a = lines
+        n = len(a)
+        if n < 2:
+            return None
+    else:
+        n = len(lines)
+        if n < 2 or set(map(len, lines)) != {80}:
+            return None
+        try:
+            flat = "".join(lines).encode("latin-1")
+        except UnicodeEncodeError:
+            return None
+        a = np.frombuffer(flat, dtype=np.uint8).reshape(n, 80)
     order = np.full(256, -1, dtype=np.int64)
     for k, c in enumerate(SECTIONS):
         order[ord(c)] = k
     code = order[a[:, 72]]
     if np.any(code < 0) or np.any(np.diff(code) < 0):
         return None
-    f = a[:, 73:80].astype(np.int64)
-    digit = (f >= 48) & (f <= 57)
-    space = f == 32
-    if not np.all(digit | space) or not np.all(digit[:, -1]):
+    value = _column_integers(a[:, 73:80])
+    if value is None:
         return None
-    # spaces may only lead: once a digit is seen, no space follows
-    if np.any(space[:, 1:] & np.maximum.accumulate(digit, axis=1)[:, :-1]):
-        return None
-    value = (np.where(digit, f - 48, 0) * (10 ** np.arange(6, -1, -1))).sum(axis=1)
     starts = np.searchsorted(code, np.arange(len(SECTIONS)))
     expected = np.arange(n) - starts[code] + 1
     if not np.array_equal(value, expected):
@@ -249,7 +301,7 @@ def _sections_fast(lines: list[str]):
     counts = np.bincount(code, minlength=len(SECTIONS))
     if counts[4] != 1 or counts[1] == 0 or counts[2] % 2:
         return None
-    tline = lines[-1]
+    tline = a[-1].tobytes().decode("latin-1")
     for i, c in enumerate("SGDP"):
         field = tline[8 * i : 8 * i + 8]
         cnt = field[1:].strip()
@@ -258,19 +310,38 @@ def _sections_fast(lines: list[str]):
     sec = {}
     for k, c in enumerate(SECTIONS):
         lo, hi = int(starts[k]), int(starts[k]) + int(counts[k])
-        sec[c] = list(zip(range(lo + 1, hi + 1), lines[lo:hi]))
+        rows = _Rows(a, lo, hi)
+        sec[c] = rows if c == "P" else list(rows)
     return sec
 
 
+def _column_integers(f: np.ndarray) -> np.ndarray | None:
+    """Right-justified unsigned integers in columns of a uint8 array (one per row, leading
+    blanks, at least the last column a digit); None when any row is not such a number."""
+    d = f - np.uint8(48)  # digits 0..9; a blank wraps to 240
+    digit = d <= 9
+    if not np.all(digit | (f == 32)) or not np.all(digit[:, -1]):
+        return None
+    # blanks may only lead: once a digit is seen, no blank follows
+    if np.any(~digit[:, 1:] & np.maximum.accumulate(digit, axis=1)[:, :-1]):
+        return None
+    d[~digit] = 0
+    return d.astype(np.int64) @ (10 ** np.arange(f.shape[1] - 1, -1, -1, dtype=np.int64))
+
+
 # -- parameters ----------------------------------------------------------------------------------
-def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of) -> list:
-    """Parameters of one record up to its record delimiter (IGES 5.3 §2.2.3)."""
+def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of, strip: bool = True) -> list:
+    """Parameters of one record up to its record delimiter (IGES 5.3 §2.2.3).
+
+    ``strip=False``: a record without strings comes back as a plain list whose tokens
+    may keep blanks around them (:class:`_Params` strips what it reads one by one, and
+    reads runs of reals without stripping them), which saves a pass over every token."""
     if "H" not in data:
         end = data.find(rd)
         if end < 0:
             src.error("missing record delimiter", line_of(len(data) - 1))
         body = data[:end]
-        if " " not in body:
+        if " " not in body or not strip:
             return body.split(pd)
         return [t.strip() for t in body.split(pd)]
     out = _StrTokens()
@@ -355,7 +426,7 @@ class _Params:
             self.error(f"{what} is missing (record ends early)")
         tok = self.t[self.i]
         self.i += 1
-        return tok
+        return tok if self.has_strings else tok.strip()
 
     def int(self, what: str, default: int | None = None, lo: int | None = None, hi: int | None = None) -> int:
         tok = self._next(what, default is not None)
@@ -388,19 +459,25 @@ class _Params:
         try:
             if self.has_strings and any(isinstance(t, _Str) for t in toks):
                 raise ValueError
-            # one regex pass over the joined tokens instead of one per token
-            joined = ",".join(toks)
-            if count and not _REALS.fullmatch(joined):
+            # Fast path: only the characters of IGES reals (one C pass over the joined
+            # tokens), then Python's float per token (faster than a regex pass and numpy's
+            # text parser). float() accepts more than IGES (a 5-digit exponent), never a
+            # character outside the set; empty tokens, repeated signs or points raise and
+            # take the checked path below, which names the bad token.
+            joined = ",".join(toks).encode("latin-1")
+            # blanks around a token are allowed (float() skips them; blanks inside a
+            # token make float() raise)
+            if joined.translate(None, _REAL_CHARS):
                 raise ValueError
-            if "D" in joined or "d" in joined:
-                joined = joined.replace("D", "E").replace("d", "e")
-            # the text was checked by _REALS: numpy's C text parser reads it at once
-            a = np.fromstring(joined, dtype=np.float64, sep=",") if count else np.empty(0)
+            if b"D" in joined or b"d" in joined:
+                toks = joined.replace(b"D", b"E").replace(b"d", b"e").split(b",")
+            a = np.array(list(map(float, toks)), dtype=np.float64) if count else np.empty(0)
             if a.size != count or not np.all(np.isfinite(a)):
                 raise ValueError
-        except ValueError:
+        except (ValueError, UnicodeEncodeError):
             a = np.empty(count)
-            for k, t in enumerate(toks):
+            for k, t in enumerate(self.t[self.i : self.i + count]):
+                t = t if isinstance(t, _Str) else t.strip()
                 v = _parse_real(t, 0.0)
                 if v is None:
                     self.error(f"{what}[{k}]: expected a finite real number, got {str(t)[:40]!r}", self.i + k)
@@ -653,7 +730,7 @@ def _raw_pointers(etype: int, tokens, n_entities: int) -> list[int]:
     out = []
     for k in idx:
         if k < len(tokens):
-            v = _parse_int(tokens[k])
+            v = _parse_int(tokens[k] if isinstance(tokens[k], _Str) else tokens[k].strip())
             if v is not None and v > 0 and v % 2 == 1 and v <= 2 * n_entities - 1:
                 out.append((v - 1) // 2)
     return out
@@ -671,12 +748,25 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
     src = _Source(path)
     lenient = not strict
     notes: list = [] if lenient else None
-    lines = _split_lines(data, lenient, notes)
-    sec = _sections(lines, src, lenient, notes)
+    fixed = _fixed_array(data)
+    sec = _sections_fast(fixed) if fixed is not None else None
+    if sec is None:
+        lines = _split_lines(data, lenient, notes)
+        sec = _sections(lines, src, lenient, notes)
     start = "\n".join(line[:72].rstrip() for _, line in sec["S"])
     header, pd, rd, defaulted = _parse_global(sec["G"], src, notes)
 
     dlines, plines = sec["D"], sec["P"]
+    # columns 1-64 of every P line (80 columns each: _sections checks it) and the back
+    # pointers of columns 66-72, for slicing records out without a loop per line
+    if isinstance(plines, _Rows):
+        pdata = plines.columns(0, 64).tobytes().decode("latin-1")
+        pback = _column_integers(plines.columns(65, 72))
+    else:
+        pdata = "".join([text[:64] for _, text in plines])
+        pback = None
+    if pback is None:
+        pback = [text[65:72] for _, text in plines]
     n = len(dlines) // 2
     skipped: dict = {}
     directory: list = [None] * n
@@ -747,22 +837,24 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
     def _build_one(i: int, depth: int):
         etype, ptr, count, form, status, level, color, label, subscript, tr, l1 = directory[i]
         first_line = plines[ptr - 1][0]
-        chunks = []
         seq = 2 * i + 1
         expected = f"{seq:7d}"
-        for k in range(ptr - 1, ptr - 1 + count):
-            ln, text = plines[k]
-            if text[65:72] != expected:  # the usual right-justified form, else check properly
+        back = pback[ptr - 1 : ptr - 1 + count]
+        if not (np.all(back == seq) if isinstance(back, np.ndarray) else back.count(expected) == count):
+            for k in range(ptr - 1, ptr - 1 + count):  # not the usual right-justified form
+                ln, text = plines[k]
                 back = text[65:72].strip()
                 if not _DIGITS.fullmatch(back) or int(back) != seq:
                     src.error(f"parameter line points back to DE {text[65:72].strip()!r}; expected {seq}", ln)
-            chunks.append(text[:64])
-        data = "".join(chunks)
+        # the Parameter Data text of the section is joined once; a record is a slice of it
+        data = pdata[64 * (ptr - 1) : 64 * (ptr - 1 + count)]
 
         def line_of(offset):
             return first_line + min(max(offset, 0) // 64, count - 1)
 
-        tokens = _tokenize(data, pd, rd, src, line_of)
+        tokens = _tokenize(data, pd, rd, src, line_of, strip=False)
+        if type(tokens) is not _StrTokens and tokens:
+            tokens[0] = tokens[0].strip()
 
         def line_of_index(index):
             # locate the index-th parameter by counting delimiters (only on error)
@@ -805,7 +897,8 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
                 cls, fn = builders[etype]
                 record = cls(**fn(p, resolve, form), **common)
             else:
-                record = GenericEntity(entity_type=etype, entity_form=form, parameters=tuple(tokens[1:]), **common)
+                record = GenericEntity(entity_type=etype, entity_form=form, parameters=tuple(
+                    t if isinstance(t, _Str) else t.strip() for t in tokens[1:]), **common)
             check(record)
         except IgesError as exc:
             if exc.line is not None:

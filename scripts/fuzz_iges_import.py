@@ -46,7 +46,17 @@ def base_files() -> list[str]:
     out = list(fuzz.base_files())
     out += [cases.subfigure_instance()[0], cases.nested_composites(3)[0], cases.plane_face_with_hole()[0],
             cases.tabulated_cylinder_face()[0], cases.trimmed_with_transforms()[0],
-            cases.composite_with_transform()[0]]
+            cases.composite_with_transform()[0], cases.cylinder_face()[0]]
+    try:  # an OpenCASCADE-written B-rep solid on the analytic surfaces 190-198
+        import tempfile
+
+        vs_occ = _load("iges_vs_occ", ROOT / "tests" / "iges" / "test_import_vs_occ.py")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = pathlib.Path(tmp) / "primitives.igs"
+            vs_occ._primitives_brep_iges(path)
+            out.append(path.read_text())
+    except ImportError:
+        pass  # no OCP here: the other bases still run
     return out
 
 

@@ -13,6 +13,9 @@ import sys
 
 HERE = pathlib.Path(__file__).resolve().parent
 SUITE_BYTES = 45_000
+#: Larger files in the suite for what only they show: shell1.brep.igs has a face whose
+#: loop steps along a degenerate side by a vertex edge (4 s).
+SUITE_EXTRA = {"shell1.brep.igs"}
 #: Bounding boxes of the trimmed faces' meshes agree with OCC's exact ones to this fraction of
 #: the model's diagonal (the meshes are within 1e-3 of each face's size).
 BBOX_TOL = 2e-3
@@ -36,14 +39,14 @@ def test_small_corpus_files_against_opencascade():
         # unreachable corpus is a failure, never a silent pass
         raise AssertionError(f"the public IGES corpus could not be fetched: {exc}") from None
     assert len(files) >= 60
-    small = [f for f in files if f.path.stat().st_size <= SUITE_BYTES]
+    small = [f for f in files if f.path.stat().st_size <= SUITE_BYTES or f.name in SUITE_EXTRA]
     rows = corpus.compare(small)
     print("\n" + corpus.table(rows))
     by_name = {r.name: r for r in rows}
-    # files as published, and OCC's trimmed-face files: every face OCC makes, where OCC
-    # makes them, and at OCC's size and place
+    # files as published, OCC's trimmed-face files and OCC's B-rep solids (faces on the
+    # analytic surfaces 190-198 too): every face OCC makes, at OCC's size and place
     for r in rows:
-        if r.name.endswith(".brep.igs") or not r.occ_faces:
+        if not r.occ_faces:
             continue
         assert r.faces == r.occ_faces, (r.name, r.faces, r.occ_faces, r.note)
         assert r.bbox_error is not None and r.bbox_error <= BBOX_TOL, (r.name, r.bbox_error)
@@ -52,6 +55,8 @@ def test_small_corpus_files_against_opencascade():
     # OCC enlarges it; ours is the sampled exact curves; not explained further yet)
     assert by_name["edge.faces.igs"].bbox_error <= 1e-6, by_name["edge.faces.igs"]
     assert by_name["example-arcs.iges"].bbox_error <= 1e-4, by_name["example-arcs.iges"]
-    # B-rep solids: faces on 128 surfaces come in; faces on analytic 190-198 surfaces are
-    # skipped and reported, never a foreign error
-    assert by_name["wing.brep.igs"].faces == by_name["wing.brep.igs"].occ_faces
+    # B-rep solids whose faces lie on analytic surfaces (190 planes, 192 cylinders, 196
+    # spheres crossed at their poles) come in whole
+    assert any(n.endswith(".brep.igs") for n in by_name), sorted(by_name)
+    assert by_name["fuse.brep.igs"].faces == by_name["fuse.brep.igs"].occ_faces == 10
+    assert by_name["shell1.brep.igs"].faces == by_name["shell1.brep.igs"].occ_faces == 99

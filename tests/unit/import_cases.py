@@ -225,3 +225,31 @@ def tabulated_cylinder_face() -> tuple[str, float]:
     inner = len(ents)
     ents.append((144, ["@2", 1, 1, f"@{outer}", f"@{inner}"], 0, 0, "00"))
     return raw_file(ents), 0.5 * math.pi * 2.0 * 3.0
+
+
+def cylinder_face() -> tuple[str, float]:
+    """A 144 over a 192 right circular cylinder (radius 2 about z, form 1), bounded by a
+    model-space loop only (PREF 2, no parameter curve) across the angle pi where atan2
+    jumps: the arc 135..225 degrees at z = 0, up 3, back at z = 3, down; the 144 carries a
+    124 (rotation and translation). Returns (text, area 2 * (pi / 2) * 3)."""
+    ents = [(116, [0.0, 0.0, 0.0], 0, 0, "01"),                       # 1 location
+            (123, [0.0, 0.0, 1.0], 0, 0, "01"),                       # 2 axis
+            (123, [1.0, 0.0, 0.0], 0, 0, "01"),                       # 3 reference direction
+            (192, ["@1", "@2", 2.0, "@3"], 1, 0, "01")]               # 4
+    a0, a1 = 0.75 * math.pi, 1.25 * math.pi
+    p0 = [2 * math.cos(a0), 2 * math.sin(a0)]
+    p1 = [2 * math.cos(a1), 2 * math.sin(a1)]
+    first = len(ents) + 1
+    for arc in (examples.arc126([0.0, 0.0], 2.0, a0, a1, z=0.0), None, examples.arc126([0.0, 0.0], 2.0, a1, a0, z=3.0)):
+        if arc is None:
+            ents.append((110, [*p1, 0.0, *p1, 3.0], 0, 0, "01"))
+            continue
+        k = arc.control_points
+        ents.append((126, [2, 2, 0, 0, 0, 0, *arc.knots, *arc.weights, *k.ravel(), 0.0, 1.0], 0, 0, "01"))
+    ents.append((110, [*p0, 3.0, *p0, 0.0], 0, 0, "01"))
+    ents.append((102, [4] + [f"@{first + i}" for i in range(4)], 0, 0, "01"))
+    ents.append((142, [0, "@4", 0, f"@{len(ents)}", 2], 0, 0, "01"))
+    loop = len(ents)
+    ents.append((124, matrix_params(rot([1.0, 2.0, 2.0], 0.6), [1.0, -2.0, 0.5]), 0, 0, "01"))
+    ents.append((144, ["@4", 1, 0, f"@{loop}"], 0, len(ents), "00"))
+    return raw_file(ents), 2 * (0.5 * math.pi) * 3
