@@ -315,13 +315,54 @@ class BladeSurface:
             jet.stack_into(out, k, order)
         return out
 
+    def _points(self, xi, eta):
+        """(x, y, z) of b(ξ, η) in plain numpy: the value part of :meth:`_jets`, the same
+        operations in the same order (so the same rounding), without the Jet bookkeeping
+        that dominates the cost of the many small evaluations in tip smoothing."""
+        xi = np.asarray(xi, dtype=np.float64)
+        if np.any(~np.isfinite(xi)):
+            raise GeometryError("xi contains NaN or infinite values")
+        eta = self._check_eta(eta)
+        h = self.hand
+        psi = np.mod(TWO_PI * xi if h > 0 else TWO_PI * (1.0 - xi), TWO_PI)
+        S = self.section.thickness(psi)
+        xj = 0.5 * (1.0 + np.cos(psi))
+        Q = self.radial(eta)
+        if self.chord_squared:
+            self._snap_tip(Q, eta)
+        q = Q[..., _CHORD]
+        c = np.sqrt(q) if self.chord_squared else q
+        P, th, iG, tc = Q[..., _PITCH], Q[..., _SKEW], Q[..., _RAKE], Q[..., _TC]
+        r = self.radius * eta
+        p = P * (1.0 / (TWO_PI * r))
+        cos_phi = 1.0 / np.sqrt(p * p + 1.0)
+        sin_phi = p * cos_phi
+        z_m = iG + th * P * (1.0 / TWO_PI)
+        if self.section.meanline is not None:
+            fc = Q[..., _FC]
+            m = fc * self.section.camber(xj, 0)
+            mp = fc * self.section.camber(xj, 1)
+            w = 1.0 / np.sqrt(mp * mp + 1.0)
+            Sw = tc * S * w
+            X = xj + -(Sw * mp)
+            Y = m + Sw
+        else:
+            X = xj
+            Y = tc * S
+        A = X + -0.5
+        ds = c * (-(A * cos_phi) + -(Y * sin_phi))
+        z = z_m + c * (A * sin_phi + -(Y * cos_phi))
+        ang = ds * (1.0 / r) + -th
+        rs = r * np.sin(ang)
+        return (-rs if h < 0 else rs), r * np.cos(ang), z
+
     def evaluate(self, xi, eta) -> np.ndarray:
         """Points b(ξ, η): shape B + (3,), B the broadcast shape of ξ and η."""
         shape = np.broadcast_shapes(np.shape(xi), np.shape(eta))
-        comps = self._jets(xi, eta, 0)
+        comps = self._points(xi, eta)
         out = np.empty(shape + (3,))
-        for k, jet in enumerate(comps):
-            out[..., k] = jet.v
+        for k, v in enumerate(comps):
+            out[..., k] = v
         return out
 
     __call__ = evaluate
