@@ -38,6 +38,7 @@ from ..nurbs import BSplineSurface
 from ..nurbs.basis import basis_functions, find_span
 from ..nurbs.fitting import average_knots, greville_abscissae, interpolate_at
 from ..nurbs.skinning import transfinite_interpolation
+from .batch import curve_displacement, curve_parameters
 from .corners import blade_points
 
 DEGREE = 3
@@ -52,12 +53,13 @@ MAX_KNOTS = 4000
 
 def evaluate_curves(blade, curves, t) -> tuple[np.ndarray, np.ndarray]:
     """Points (K, n, 3) and blade parameters (K, n, 2) of K curves at the same t (n,),
-    with one evaluation of b for all of them."""
+    with one evaluation of b for all of them (and the curves' parameters in batches,
+    :mod:`.batch`)."""
     t = np.asarray(t, dtype=np.float64)
-    P = np.stack([c.parameters(t) for c in curves])
+    P = curve_parameters(curves, t)
     X = blade_points(blade, P)
     for k, c in enumerate(curves):
-        d = c.displacement(t)
+        d = curve_displacement(c, t, X[k])
         if d is not None:
             X[k] += d
     return X, P

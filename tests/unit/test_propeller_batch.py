@@ -1,0 +1,66 @@
+"""Batched evaluation used for the speed of tip smoothing (issue 22): many splines with
+their own knots at once, and the curves of Hally §8 in groups, against the one-by-one
+evaluation they replace."""
+import pathlib
+
+import numpy as np
+import pytest
+from scipy.interpolate import make_interp_spline
+
+from bladesmith.geometry.errors import GeometryError
+from bladesmith.geometry.nurbs.curve import evaluate_splines
+from bladesmith.geometry.propeller import Propeller
+from bladesmith.geometry.propeller.batch import curve_displacement, curve_parameters
+from bladesmith.geometry.propeller.corners import blade_points, corner_points
+from bladesmith.geometry.propeller.edge_curves import build_edge_curves
+from bladesmith.geometry.propeller.side_curves import side_curves
+from bladesmith.geometry.propeller.smoothing import SmoothingSettings
+
+PRESETS = pathlib.Path(__file__).resolve().parents[2] / "data" / "propellers"
+
+
+def test_evaluate_splines_matches_each_spline():
+    rng = np.random.default_rng(7)
+    splines = []
+    for k in range(9):
+        n = int(rng.integers(5, 40))
+        x = np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0.0, 1.0, n - 2)]))
+        splines.append(make_interp_spline(x, rng.normal(size=(n, 2)), k=3))
+    t = np.concatenate([[0.0, 1.0, 0.5], rng.uniform(0.0, 1.0, 50), splines[3].t[5:9]])
+    got = evaluate_splines([s.t for s in splines], [s.c for s in splines], 3, t)
+    want = np.stack([s(t) for s in splines])
+    assert got.shape == want.shape
+    assert np.max(np.abs(got - want)) < 1e-12 * max(1.0, np.abs(want).max())
+
+
+def test_evaluate_splines_refuses_mismatched_knots():
+    s = make_interp_spline(np.linspace(0, 1, 8), np.arange(16.0).reshape(8, 2), k=3)
+    with pytest.raises(GeometryError):
+        evaluate_splines([s.t[:-1]], [s.c], 3, [0.5])
+
+
+@pytest.fixture(scope="module")
+def dtmb_curves():
+    model = Propeller.from_toml(PRESETS / "dtmb4119.toml").build()
+    blade = model.blade
+    settings = SmoothingSettings()
+    corners = corner_points(blade, model.blade_hub_intersection, settings.defining_points)
+    curves = build_edge_curves(blade, corners, side_curves(blade, corners), settings)
+    return blade, curves
+
+
+def test_curve_parameters_match_one_by_one(dtmb_curves):
+    blade, curves = dtmb_curves
+    family = curves.leading + curves.trailing + curves.tip  # TFI curves, cuts, smoothed cuts, a reversed cut
+    kinds = {type(c).__name__ for c in family}
+    assert {"TFICurve", "SplineCurve", "ReversedCurve"} <= kinds
+    t = np.linspace(0.0, 1.0, 37)
+    got = curve_parameters(family, t)
+    want = np.stack([c.parameters(t) for c in family])
+    assert np.max(np.abs(got - want)) < 1e-13
+    # the smoothed cuts' displacement given the exact points equals their own
+    smoothed = [c for c in family if c.displacement(t) is not None]
+    assert smoothed
+    for c in smoothed:
+        exact = blade_points(blade, c.parameters(t))
+        assert np.max(np.abs(curve_displacement(c, t, exact) - c.displacement(t))) < 1e-15 * blade.radius + 1e-15
