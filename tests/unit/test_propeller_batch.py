@@ -64,3 +64,32 @@ def test_curve_parameters_match_one_by_one(dtmb_curves):
     for c in smoothed:
         exact = blade_points(blade, c.parameters(t))
         assert np.max(np.abs(curve_displacement(c, t, exact) - c.displacement(t))) < 1e-15 * blade.radius + 1e-15
+
+
+def _jet_derivatives(blade, xi, eta, order):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        comps = blade._jets(xi, eta, order)
+    out = np.zeros(np.broadcast_shapes(np.shape(xi), np.shape(eta)) + (order + 1, order + 1, 3))
+    for k, jet in enumerate(comps):
+        jet.stack_into(out, k, order)
+    return out
+
+
+@pytest.mark.parametrize("hand", [1, -1])
+@pytest.mark.parametrize("cambered", [True, False])
+def test_blade_fast_paths_equal_the_jets(hand, cambered):
+    """b and its first derivatives written out (the speed path) give the jets' numbers bit
+    for bit, tip points (infinite η-derivatives) included."""
+    import dataclasses
+
+    blade = Propeller.from_toml(PRESETS / "dtmb4119.toml").build().blade
+    section = blade.section if cambered else dataclasses.replace(blade.section, meanline=None)
+    blade = dataclasses.replace(blade, hand=hand, section=section)
+    rng = np.random.default_rng(3)
+    xi = rng.uniform(-1.0, 2.0, 400)
+    eta = rng.uniform(blade.eta_min, 1.0, 400)
+    eta[:4] = 1.0
+    assert np.array_equal(blade.evaluate(xi, eta), _jet_derivatives(blade, xi, eta, 0)[..., 0, 0, :])
+    assert np.array_equal(blade.derivatives(xi, eta, 1), _jet_derivatives(blade, xi, eta, 1), equal_nan=True)
+    grid = (xi[:30, None], eta[None, :20])
+    assert np.array_equal(blade.derivatives(*grid, 1), _jet_derivatives(blade, *grid, 1), equal_nan=True)
