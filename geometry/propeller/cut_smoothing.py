@@ -33,6 +33,7 @@ the accuracy away from the edge).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -205,7 +206,7 @@ def stable_strength_scale(W: np.ndarray, beta: np.ndarray) -> float:
     rho = 0.0
     for _ in range(STABILITY_POWER_ITERATIONS):
         y = B @ x
-        rho = float(np.linalg.norm(y))
+        rho = math.sqrt(y.dot(y))  # np.linalg.norm's own formula, without its per-call checks
         if rho == 0.0:
             return 1.0
         x = y / rho
@@ -326,17 +327,23 @@ def smooth_cut(blade, cut, tip_distance: float, *, d_t: float, d_e: float, stren
             break
         checkpoints.append(c)
         Ys.append(Y)
-    offsets, curves_w = [], [Xw]
+    offsets, curves_w = [], [Xw[None]]
     if Ys:
         Yk = np.stack(Ys, axis=1)  # (N, checkpoints, 3)
         through = make_interp_spline(t, Yk, k=3)
         disp = make_interp_spline(t, Yk - Y0[:, None], k=3)
-        for i in range(len(Ys)):
-            off = BlendedOffset(blade, cut.curve, BSpline(through.t, through.c[:, i], 3),
-                                BSpline(disp.t, disp.c[:, i], 3), weight)
-            offsets.append(off)
-            curves_w.append(Xw + off.on_exact(tw, Xw))
-    excess = curve_excess_many(tw, np.stack(curves_w))
+        offsets = [BlendedOffset(blade, cut.curve, BSpline(through.t, through.c[:, i], 3),
+                                 BSpline(disp.t, disp.c[:, i], 3), weight) for i in range(len(Ys))]
+        # BlendedOffset.on_exact for every checkpoint at once
+        d = np.moveaxis(disp(tw), 1, 0)  # (checkpoints, n, 3)
+        w = np.clip(weight(tw), 0.0, 1.0)
+        out = np.array(d)
+        on = w > 0.0
+        if np.any(on):
+            Son = np.moveaxis(through(tw[on]), 1, 0)
+            out[:, on] = d[:, on] + w[on, None] * (Son - Xw[on] - d[:, on])
+        curves_w.append(Xw + out)
+    excess = curve_excess_many(tw, np.concatenate(curves_w))
     first = excess[0]
     slack = GUARD_RELATIVE_SLACK * first + GUARD_RELATIVE_SLACK / d_e
     best_e, best_n, best_Y, best_off = first, 0, Y0, None
