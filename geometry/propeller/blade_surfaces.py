@@ -106,16 +106,17 @@ def common_knots(blade, curves, tolerance: float, report: dict | None = None):
         rounds += 1
         U = _clamped(interior)
         g = greville_abscissae(U, DEGREE)
-        Xg, Pg = evaluate_curves(blade, curves, g)
-        C = fit_rows(U, Xg)
         breaks = np.unique(U)
         local = (np.arange(1, SAMPLES_PER_SPAN) / SAMPLES_PER_SPAN)
         ts = (breaks[:-1, None] + np.diff(breaks)[:, None] * local[None, :]).ravel()
         new = ~np.isin(ts, cache_t)
+        # one evaluation of the curves per round: the Greville abscissae and the new samples
+        Xa, Pa = evaluate_curves(blade, curves, np.concatenate([g, ts[new]]))
+        Xg, Pg = Xa[:, : g.size], Pa[:, : g.size]
+        C = fit_rows(U, Xg)
         if np.any(new):
-            Xn, _ = evaluate_curves(blade, curves, ts[new])
             cache_t = np.concatenate([cache_t, ts[new]])
-            cache_X = np.concatenate([cache_X, Xn], axis=1)
+            cache_X = np.concatenate([cache_X, Xa[:, g.size :]], axis=1)
         order = np.argsort(cache_t)
         cache_t, cache_X = cache_t[order], cache_X[:, order]
         F = cache_X[:, np.searchsorted(cache_t, ts)]
