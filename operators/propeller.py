@@ -415,10 +415,19 @@ def _section_key(propeller: Propeller):
     return key + (stamp,)
 
 
+#: The last model built, with its definition and section key: an edit that leaves the
+#: definition as it is (a smoothing or display setting) reuses it, and with it what was
+#: computed on it (the blade–hub intersection, the marching surrogate of the cuts).
+_LAST_MODEL: list = []
+
+
 def build_model(propeller: Propeller) -> PropellerModel:
     """``propeller.build()``, reusing the section shape of a recent regeneration with the
-    same [section] (building it costs about as much as the rest of the model)."""
+    same [section] (building it costs about as much as the rest of the model), and the
+    whole model when the definition is unchanged."""
     key = _section_key(propeller)
+    if _LAST_MODEL and _LAST_MODEL[0] == propeller and _LAST_MODEL[1] == key:
+        return _LAST_MODEL[2]
     section = _SECTION_CACHE.get(key)
     if section is None:
         section = propeller.section.shape(propeller.base_dir, propeller.source)
@@ -426,7 +435,9 @@ def build_model(propeller: Propeller) -> PropellerModel:
             _SECTION_CACHE.pop(next(iter(_SECTION_CACHE)))
         _SECTION_CACHE[key] = section
     blade = BladeSurface.from_definition(propeller, section=section)
-    return PropellerModel(definition=propeller, blade=blade, hub=Hub.from_definition(propeller))
+    model = PropellerModel(definition=propeller, blade=blade, hub=Hub.from_definition(propeller))
+    _LAST_MODEL[:] = [propeller, key, model]
+    return model
 
 
 def compute_display(propeller: Propeller, *, display_tolerance: float, smooth_tip: bool = False,

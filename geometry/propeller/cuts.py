@@ -47,6 +47,7 @@ so the cut crosses ξ = 0 continuously (Hally §6, last paragraph).
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -198,6 +199,19 @@ class BladeCache:
             dw_deta = -0.5 / w
             out[:, 0, 1] = np.einsum("na,nabk,nb->nk", S, C, dR) * (dw_deta / self.hw)[:, None]
         return out
+
+
+_BLADE_CACHES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def blade_cache(blade) -> BladeCache:
+    """The :class:`BladeCache` of ``blade`` (default cells), built once per blade object:
+    a blade is immutable, and an edit of the smoothing settings marches new cuts on the
+    same blade (the operator reuses the model when the definition did not change)."""
+    cache = _BLADE_CACHES.get(blade)
+    if cache is None:
+        cache = _BLADE_CACHES[blade] = BladeCache(blade)
+    return cache
 
 
 def chart_derivatives(deriv, eta_min):
