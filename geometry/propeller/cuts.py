@@ -124,6 +124,27 @@ def cut_parameters(a: np.ndarray, m: int) -> np.ndarray:
     return t
 
 
+def _powers(s: np.ndarray) -> np.ndarray:
+    """(1, s, s², s³) as columns (n, 4) (filled in place: np.stack costs more than the
+    arithmetic at the march's sizes)."""
+    out = np.empty((s.size, 4))
+    out[:, 0] = 1.0
+    out[:, 1] = s
+    out[:, 2] = s * s
+    out[:, 3] = out[:, 2] * s
+    return out
+
+
+def _power_derivatives(s: np.ndarray) -> np.ndarray:
+    """(0, 1, 2s, 3s²) as columns (n, 4)."""
+    out = np.empty((s.size, 4))
+    out[:, 0] = 0.0
+    out[:, 1] = 1.0
+    out[:, 2] = 2 * s
+    out[:, 3] = 3 * s * s
+    return out
+
+
 def _fail(label, p, what):
     return GeometryError(
         f"blade cut {label}: {what} at ξ = {p[0]:.6g}, η = {p[1]:.6g} "
@@ -186,11 +207,7 @@ class BladeCache:
         j = np.minimum(y.astype(np.intp), self.n_w - 1)
         r = y - j
         C = self.coef[i, j]
-        one, zero = np.ones_like(s), np.zeros_like(s)
-        S = np.stack([one, s, s * s, s * s * s], axis=1)
-        dS = np.stack([zero, one, 2 * s, 3 * s * s], axis=1)
-        Rr = np.stack([one, r, r * r, r * r * r], axis=1)
-        dR = np.stack([zero, one, 2 * r, 3 * r * r], axis=1)
+        S, dS, Rr, dR = _powers(s), _power_derivatives(s), _powers(r), _power_derivatives(r)
         out = np.zeros((len(p), order + 1, order + 1, 3))
         CR = np.einsum("nabk,nb->nak", C, Rr)
         out[:, 0, 0] = np.einsum("na,nak->nk", S, CR)
@@ -260,7 +277,9 @@ class _PlaneSolver:
         D = self.deriv(p, 1)
         n = self.n[idx]
         f = np.einsum("ij,ij->i", D[:, 0, 0] - self.x0[idx], n)
-        g = np.stack([np.einsum("ij,ij->i", D[:, 1, 0], n), np.einsum("ij,ij->i", D[:, 0, 1], n)], axis=1)
+        g = np.empty((len(f), 2))
+        g[:, 0] = np.einsum("ij,ij->i", D[:, 1, 0], n)
+        g[:, 1] = np.einsum("ij,ij->i", D[:, 0, 1], n)
         return f, g, D
 
     def newton_line(self, trial, m, idx):
