@@ -174,7 +174,7 @@ class BladeCache:
         wg = np.arange(n_w + 1) * self.hw
         wg_eval = np.maximum(wg, np.sqrt(ETA_TIP_GUARD))
         eta = np.clip(1.0 - wg_eval**2, blade.eta_min, 1.0 - ETA_TIP_GUARD)
-        D = blade.derivatives(xg[:-1, None], eta[None, :], 2)  # (n_xi, n_w+1, 3, 3, 3)
+        D = blade.mixed_derivatives(xg[:-1, None], eta[None, :])  # (n_xi, n_w+1, 3, 3, 3)
         D = np.concatenate([D, D[:1]], axis=0)
         dw = -2.0 * wg_eval[None, :, None]  # dη/dw
         F = D[..., 0, 0, :]

@@ -93,3 +93,14 @@ def test_blade_fast_paths_equal_the_jets(hand, cambered):
     assert np.array_equal(blade.derivatives(xi, eta, 1), _jet_derivatives(blade, xi, eta, 1), equal_nan=True)
     grid = (xi[:30, None], eta[None, :20])
     assert np.array_equal(blade.derivatives(*grid, 1), _jet_derivatives(blade, *grid, 1), equal_nan=True)
+
+
+def test_mixed_derivatives_equal_the_full_second_order():
+    blade = Propeller.from_toml(PRESETS / "dtmb4119.toml").build().blade
+    xi = np.linspace(0.0, 1.0, 64, endpoint=False)[:, None]
+    eta = np.linspace(blade.eta_min, 1.0 - 1e-12, 17)[None, :]
+    full = blade.derivatives(xi, eta, 2)
+    mixed = blade.mixed_derivatives(xi, eta)
+    for k, l in ((0, 0), (1, 0), (0, 1), (1, 1)):
+        assert np.array_equal(mixed[..., k, l, :], full[..., k, l, :])
+    assert not np.any(mixed[..., 2, 0, :]) and not np.any(mixed[..., 0, 2, :])
