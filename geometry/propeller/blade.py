@@ -87,6 +87,29 @@ def _radial_spline(eta_stations: np.ndarray, values: np.ndarray, eta_min: float)
     return PPoly(c, x, extrapolate=False)
 
 
+#: Recent results of the outline check, keyed by section and (t/c, f/c) values: a live
+#: edit of pitch, chord, skew or rake leaves the sections as they are.
+_OUTLINE_CHECKS: dict = {}
+OUTLINE_CHECK_CACHE_SIZE = 8
+
+
+def _simple_outlines(section: SectionShape, tc: np.ndarray, fc: np.ndarray) -> np.ndarray:
+    """Whether the section outlines with thickness ratios ``tc`` and camber ratios ``fc``
+    (OUTLINE_CHECK_POINTS points each) are simple polygons, remembered for the last few
+    (section, tc, fc): the check is most of the cost of building a blade."""
+    key = (id(section), tc.tobytes(), fc.tobytes())
+    hit = _OUTLINE_CHECKS.get(key)
+    if hit is not None and hit[0] is section:  # the section is held, so its id is not reused
+        return hit[1]
+    psi = np.linspace(0.0, TWO_PI, OUTLINE_CHECK_POINTS, endpoint=False)
+    simple = polygons_are_simple(section.points(psi[None, :], tc[:, None], fc[:, None]))
+    simple.flags.writeable = False
+    while len(_OUTLINE_CHECKS) >= OUTLINE_CHECK_CACHE_SIZE:
+        _OUTLINE_CHECKS.pop(next(iter(_OUTLINE_CHECKS)))
+    _OUTLINE_CHECKS[key] = (section, simple)
+    return simple
+
+
 @dataclass(frozen=True)
 class SectionMeasurement:
     """A blade section cut at radius r, measured on the developed cylinder (metres,
@@ -182,9 +205,7 @@ class BladeSurface:
         # self-intersection of the section at every station and at the lowest η
         check_eta = np.concatenate([self.stations[self.stations < 1.0], [self.eta_min]])
         Qs = self.radial(check_eta)
-        psi = np.linspace(0.0, TWO_PI, OUTLINE_CHECK_POINTS, endpoint=False)
-        outlines = self.section.points(psi[None, :], Qs[:, _TC, None], Qs[:, _FC, None])
-        simple = polygons_are_simple(outlines)
+        simple = _simple_outlines(self.section, Qs[:, _TC], Qs[:, _FC])
         if not np.all(simple):
             k = int(np.argmin(simple))
             e, q = check_eta[k], Qs[k]

@@ -104,3 +104,28 @@ def test_mixed_derivatives_equal_the_full_second_order():
     for k, l in ((0, 0), (1, 0), (0, 1), (1, 1)):
         assert np.array_equal(mixed[..., k, l, :], full[..., k, l, :])
     assert not np.any(mixed[..., 2, 0, :]) and not np.any(mixed[..., 0, 2, :])
+
+
+def test_outline_check_remembered_per_section_and_ratios():
+    """The self-intersection check is remembered for a section and its (t/c, f/c) values
+    (a pitch edit reuses it), and a change of t/c on the same section is still checked
+    and refused."""
+    import dataclasses
+
+    from bladesmith.geometry.errors import DefinitionError
+    from bladesmith.geometry.propeller.blade import BladeSurface
+
+    propeller = Propeller.from_toml(PRESETS / "dtmb4119.toml")
+    section = propeller.section.shape(propeller.base_dir, propeller.source)
+    first = BladeSurface.from_definition(propeller, section=section)
+    radial = propeller.radial
+    pitched = dataclasses.replace(propeller, radial=dataclasses.replace(radial, P_D=tuple(1.01 * p for p in radial.P_D)))
+    second = BladeSurface.from_definition(pitched, section=section)  # same sections: the remembered check
+    assert np.all(second.evaluate(0.25, 0.6) != first.evaluate(0.25, 0.6))
+    t_c, f_c = list(radial.t_c), list(radial.f_c)
+    t_c[0], f_c[0] = 0.95, 0.45
+    folded = dataclasses.replace(propeller, radial=dataclasses.replace(radial, t_c=tuple(t_c), f_c=tuple(f_c)))
+    with pytest.raises(DefinitionError, match="self-intersects"):
+        BladeSurface.from_definition(folded, section=section)
+    with pytest.raises(DefinitionError, match="self-intersects"):  # and again, from the memory
+        BladeSurface.from_definition(folded, section=section)
