@@ -36,8 +36,8 @@ With ``smooth_tip`` the blade surfaces come from
 ``geometry.propeller.smoothing.smooth_blade(model, settings, progress=...)`` (settings:
 :func:`smoothing_settings`, lengths in metres), and :func:`show_result` shows each of the
 five surfaces as a blade patch with its own Z - 1 linked copies. Smoothing runs on every
-edit while ``smooth_tip`` is on (about a second for DTMB 4119), so live editing is meant
-for the unsmoothed blade.
+edit while ``smooth_tip`` is on (about 0.33 s for DTMB 4119 on a quiet 2-core machine,
+``bench/bench_propeller_pipeline.py``), so live editing is meant for the unsmoothed blade.
 
 Units of the operator and panel settings: ``delta_c`` (Δc), ``tip_smoothing_distance``
 (d_t), ``edge_smoothing_distance`` (d_e), ``tolerance`` and ``display_tolerance`` are
