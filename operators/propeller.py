@@ -36,8 +36,8 @@ With ``smooth_tip`` the blade surfaces come from
 ``geometry.propeller.smoothing.smooth_blade(model, settings, progress=...)`` (settings:
 :func:`smoothing_settings`, lengths in metres), and :func:`show_result` shows each of the
 five surfaces as a blade patch with its own Z - 1 linked copies. Smoothing runs on every
-edit while ``smooth_tip`` is on (about a second for DTMB 4119), so live editing is meant
-for the unsmoothed blade.
+edit while ``smooth_tip`` is on (about 0.33 s for DTMB 4119 on a quiet 2-core machine,
+``bench/bench_propeller_pipeline.py``), so live editing is meant for the unsmoothed blade.
 
 Units of the operator and panel settings: ``delta_c`` (Δc), ``tip_smoothing_distance``
 (d_t), ``edge_smoothing_distance`` (d_e), ``tolerance`` and ``display_tolerance`` are
@@ -415,10 +415,19 @@ def _section_key(propeller: Propeller):
     return key + (stamp,)
 
 
+#: The last model built, with its definition and section key: an edit that leaves the
+#: definition as it is (a smoothing or display setting) reuses it, and with it what was
+#: computed on it (the blade–hub intersection, the marching surrogate of the cuts).
+_LAST_MODEL: list = []
+
+
 def build_model(propeller: Propeller) -> PropellerModel:
     """``propeller.build()``, reusing the section shape of a recent regeneration with the
-    same [section] (building it costs about as much as the rest of the model)."""
+    same [section] (building it costs about as much as the rest of the model), and the
+    whole model when the definition is unchanged."""
     key = _section_key(propeller)
+    if _LAST_MODEL and _LAST_MODEL[0] == propeller and _LAST_MODEL[1] == key:
+        return _LAST_MODEL[2]
     section = _SECTION_CACHE.get(key)
     if section is None:
         section = propeller.section.shape(propeller.base_dir, propeller.source)
@@ -426,7 +435,9 @@ def build_model(propeller: Propeller) -> PropellerModel:
             _SECTION_CACHE.pop(next(iter(_SECTION_CACHE)))
         _SECTION_CACHE[key] = section
     blade = BladeSurface.from_definition(propeller, section=section)
-    return PropellerModel(definition=propeller, blade=blade, hub=Hub.from_definition(propeller))
+    model = PropellerModel(definition=propeller, blade=blade, hub=Hub.from_definition(propeller))
+    _LAST_MODEL[:] = [propeller, key, model]
+    return model
 
 
 def compute_display(propeller: Propeller, *, display_tolerance: float, smooth_tip: bool = False,

@@ -232,3 +232,36 @@ class BSplineCurve:
         """``count`` points at parameters uniformly spaced over the domain."""
         a, b = self.domain
         return self.evaluate(np.linspace(a, b, count))
+
+
+def evaluate_splines(knots, coefficients, degree: int, t) -> np.ndarray:
+    """K non-rational splines of one degree, each with its own knots, at the same
+    parameters: knots a sequence of K vectors (n_k + p + 1,), coefficients of K arrays
+    (n_k, dim), t (n,) inside every domain. Returns (K, n, dim).
+
+    One call instead of K: the knot vectors and coefficients are concatenated, each
+    curve's spans (NURBS Book Alg. A2.1) are shifted by its offset into the
+    concatenation, and the basis functions (Alg. A2.2) and the sums (Alg. A3.1) run over
+    all curves and parameters at once. The cost of evaluating many short splines at a
+    few points each is per-call overhead, which this removes."""
+    p = validate_degree(degree)
+    t = np.asarray(t, dtype=np.float64)
+    K = len(knots)
+    if K != len(coefficients):
+        raise GeometryError(f"evaluate_splines: {K} knot vectors for {len(coefficients)} coefficient arrays")
+    if K == 0:
+        return np.empty((0, t.size, 0))
+    U = [np.asarray(k, dtype=np.float64) for k in knots]
+    C = [np.asarray(c, dtype=np.float64).reshape(len(c), -1) for c in coefficients]
+    for k, (Uk, Ck) in enumerate(zip(U, C)):
+        if len(Uk) != len(Ck) + p + 1:
+            raise GeometryError(f"evaluate_splines: curve {k} has {len(Uk)} knots for {len(Ck)} coefficients "
+                                f"of degree {p}")
+    knot_offset = np.cumsum([0] + [len(Uk) for Uk in U[:-1]])
+    coef_offset = np.cumsum([0] + [len(Ck) for Ck in C[:-1]])
+    spans = np.stack([find_span(Uk, p, t) for Uk in U])  # (K, n), each in its own vector
+    flat_knots = np.concatenate(U)
+    flat_coefs = np.concatenate(C)
+    N = basis_functions(flat_knots, p, np.broadcast_to(t, spans.shape), spans + knot_offset[:, None])
+    rows = (spans - p + coef_offset[:, None])[..., None] + np.arange(p + 1)
+    return np.einsum("kna,knad->knd", N, flat_coefs[rows])

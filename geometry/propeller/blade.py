@@ -87,6 +87,29 @@ def _radial_spline(eta_stations: np.ndarray, values: np.ndarray, eta_min: float)
     return PPoly(c, x, extrapolate=False)
 
 
+#: Recent results of the outline check, keyed by section and (t/c, f/c) values: a live
+#: edit of pitch, chord, skew or rake leaves the sections as they are.
+_OUTLINE_CHECKS: dict = {}
+OUTLINE_CHECK_CACHE_SIZE = 8
+
+
+def _simple_outlines(section: SectionShape, tc: np.ndarray, fc: np.ndarray) -> np.ndarray:
+    """Whether the section outlines with thickness ratios ``tc`` and camber ratios ``fc``
+    (OUTLINE_CHECK_POINTS points each) are simple polygons, remembered for the last few
+    (section, tc, fc): the check is most of the cost of building a blade."""
+    key = (id(section), tc.tobytes(), fc.tobytes())
+    hit = _OUTLINE_CHECKS.get(key)
+    if hit is not None and hit[0] is section:  # the section is held, so its id is not reused
+        return hit[1]
+    psi = np.linspace(0.0, TWO_PI, OUTLINE_CHECK_POINTS, endpoint=False)
+    simple = polygons_are_simple(section.points(psi[None, :], tc[:, None], fc[:, None]))
+    simple.flags.writeable = False
+    while len(_OUTLINE_CHECKS) >= OUTLINE_CHECK_CACHE_SIZE:
+        _OUTLINE_CHECKS.pop(next(iter(_OUTLINE_CHECKS)))
+    _OUTLINE_CHECKS[key] = (section, simple)
+    return simple
+
+
 @dataclass(frozen=True)
 class SectionMeasurement:
     """A blade section cut at radius r, measured on the developed cylinder (metres,
@@ -182,9 +205,7 @@ class BladeSurface:
         # self-intersection of the section at every station and at the lowest η
         check_eta = np.concatenate([self.stations[self.stations < 1.0], [self.eta_min]])
         Qs = self.radial(check_eta)
-        psi = np.linspace(0.0, TWO_PI, OUTLINE_CHECK_POINTS, endpoint=False)
-        outlines = self.section.points(psi[None, :], Qs[:, _TC, None], Qs[:, _FC, None])
-        simple = polygons_are_simple(outlines)
+        simple = _simple_outlines(self.section, Qs[:, _TC], Qs[:, _FC])
         if not np.all(simple):
             k = int(np.argmin(simple))
             e, q = check_eta[k], Qs[k]
@@ -228,7 +249,7 @@ class BladeSurface:
         return np.clip(eta, self.eta_min, 1.0)
 
     # -- evaluation -------------------------------------------------------------------
-    def _jets(self, xi, eta, order: int):
+    def _jets(self, xi, eta, order: int, pure: bool = True):
         xi = np.asarray(xi, dtype=np.float64)
         if np.any(~np.isfinite(xi)):
             raise GeometryError("xi contains NaN or infinite values")
@@ -243,7 +264,7 @@ class BladeSurface:
         def xi_jet(f0, f1, f2):
             if order == 0:
                 return Jet(f0)
-            return Jet.of_first(f0, f1, f2 if order > 1 else 0.0, d)
+            return Jet.of_first(f0, f1, f2 if order > 1 and pure else 0.0, d)
 
         cpsi, spsi = np.cos(psi), np.sin(psi)
         S = xi_jet(S_tab(psi), S_tab(psi, 1) if order else 0.0, S_tab(psi, 2) if order > 1 else 0.0)
@@ -263,7 +284,7 @@ class BladeSurface:
         def eta_jet(col):
             if order == 0:
                 return Jet(Qd[0][..., col])
-            return Jet.of_second(Qd[0][..., col], Qd[1][..., col], Qd[2][..., col] if order > 1 else 0.0)
+            return Jet.of_second(Qd[0][..., col], Qd[1][..., col], Qd[2][..., col] if order > 1 and pure else 0.0)
 
         q = eta_jet(_CHORD)
         c = q.sqrt() if self.chord_squared else q
@@ -300,6 +321,100 @@ class BladeSurface:
         rc = r * ang.cos()
         return rs, rc, z
 
+    def _first_derivatives(self, xi, eta):
+        """(value, ∂/∂ξ, ∂/∂η) of (x, y, z): the order-1 part of :meth:`_jets` written
+        out, the same operations in the same order (so the same rounding). The ξ-only
+        and η-only factors keep their vanishing partials out of the products, as the jets
+        do, so the infinite η-derivatives at a closing tip never meet a zero."""
+        xi = np.asarray(xi, dtype=np.float64)
+        if np.any(~np.isfinite(xi)):
+            raise GeometryError("xi contains NaN or infinite values")
+        eta = self._check_eta(eta)
+        h = self.hand
+        dpsi = TWO_PI * h
+        psi = np.mod(TWO_PI * xi if h > 0 else TWO_PI * (1.0 - xi), TWO_PI)
+        cpsi, spsi = np.cos(psi), np.sin(psi)
+        # ξ-only: (value, ∂ξ)
+        S, S_a = self.section.thickness(psi), self.section.thickness(psi, 1) * dpsi
+        xj, xj_a = 0.5 * (1.0 + cpsi), (-0.5 * spsi) * dpsi
+        # η-only: (value, ∂η)
+        Q0, Q1 = self.radial(eta, 0), self.radial(eta, 1)
+        if self.chord_squared:
+            self._snap_tip(Q0, eta)
+        q, q_b = Q0[..., _CHORD], Q1[..., _CHORD]
+        if self.chord_squared:
+            c = np.sqrt(q)
+            c_b = (0.5 / c) * q_b
+        else:
+            c, c_b = q, q_b
+        P, P_b = Q0[..., _PITCH], Q1[..., _PITCH]
+        th, th_b = Q0[..., _SKEW], Q1[..., _SKEW]
+        iG, iG_b = Q0[..., _RAKE], Q1[..., _RAKE]
+        tc, tc_b = Q0[..., _TC], Q1[..., _TC]
+        R = self.radius
+        r = R * eta
+        tr, tr_b = r * TWO_PI, R * TWO_PI
+        rr = 1.0 / tr
+        rec, rec_b = rr, (-rr * rr) * tr_b
+        p, p_b = P * rec, P_b * rec + P * rec_b
+        pp, pp_b = p * p + 1.0, p_b * p + p * p_b
+        sq = np.sqrt(pp)
+        sq_b = (0.5 / sq) * pp_b
+        rr = 1.0 / sq
+        cos_phi, cos_b = rr, (-rr * rr) * sq_b
+        sin_phi, sin_b = p * cos_phi, p_b * cos_phi + p * cos_b
+        k = 1.0 / TWO_PI
+        thP, thP_b = th * P, th_b * P + th * P_b
+        z_m, z_m_b = iG + thP * k, iG_b + thP_b * k
+        if self.section.meanline is not None:
+            F0, F1, F2 = (self.section.camber(xj, n) for n in range(3))
+            fc, fc_b = Q0[..., _FC], Q1[..., _FC]
+            m, m_a, m_b = fc * F0, fc * (F1 * xj_a), fc_b * F0
+            mp, mp_a, mp_b = fc * F1, fc * (F2 * xj_a), fc_b * F1
+            mm, mm_a, mm_b = mp * mp + 1.0, mp_a * mp + mp * mp_a, mp_b * mp + mp * mp_b
+            s2 = np.sqrt(mm)
+            d1 = 0.5 / s2
+            s2_a, s2_b = d1 * mm_a, d1 * mm_b
+            rr = 1.0 / s2
+            f1 = -rr * rr
+            w, w_a, w_b = rr, f1 * s2_a, f1 * s2_b
+            tS, tS_a, tS_b = tc * S, tc * S_a, tc_b * S
+            Sw, Sw_a, Sw_b = tS * w, tS_a * w + tS * w_a, tS_b * w + tS * w_b
+            Sm, Sm_a, Sm_b = Sw * mp, Sw_a * mp + Sw * mp_a, Sw_b * mp + Sw * mp_b
+            X, X_a, X_b = xj + -Sm, xj_a + -Sm_a, -Sm_b
+            Y, Y_a, Y_b = m + Sw, m_a + Sw_a, m_b + Sw_b
+            A, A_a, A_b = X + -0.5, X_a, X_b
+            Ac_b = A_b * cos_phi + A * cos_b
+            Yc_b = Y_b * cos_phi + Y * cos_b
+            As_b = A_b * sin_phi + A * sin_b
+            Ys_b = Y_b * sin_phi + Y * sin_b
+        else:
+            A, A_a = xj + -0.5, xj_a
+            Y, Y_a, Y_b = tc * S, tc * S_a, tc_b * S
+            Ac_b = A * cos_b
+            Yc_b = Y_b * cos_phi + Y * cos_b
+            As_b = A * sin_b
+            Ys_b = Y_b * sin_phi + Y * sin_b
+        Ac, Ac_a = A * cos_phi, A_a * cos_phi
+        Ys, Ys_a = Y * sin_phi, Y_a * sin_phi
+        As, As_a = A * sin_phi, A_a * sin_phi
+        Yc, Yc_a = Y * cos_phi, Y_a * cos_phi
+        i1, i1_a, i1_b = -Ac + -Ys, -Ac_a + -Ys_a, -Ac_b + -Ys_b
+        ds, ds_a, ds_b = c * i1, c * i1_a, c_b * i1 + c * i1_b
+        i2, i2_a, i2_b = As + -Yc, As_a + -Yc_a, As_b + -Yc_b
+        z, z_a, z_b = z_m + c * i2, c * i2_a, z_m_b + (c_b * i2 + c * i2_b)
+        rr = 1.0 / r
+        rrec_b = (-rr * rr) * R
+        ang, ang_a, ang_b = ds * rr + -th, ds_a * rr, (ds_b * rr + ds * rrec_b) + -th_b
+        sa, ca = np.sin(ang), np.cos(ang)
+        si_a, si_b = ca * ang_a, ca * ang_b
+        co_a, co_b = (-sa) * ang_a, (-sa) * ang_b
+        rs, rs_a, rs_b = r * sa, r * si_a, R * sa + r * si_b
+        if h < 0:
+            rs, rs_a, rs_b = -rs, -rs_a, -rs_b
+        rc, rc_a, rc_b = r * ca, r * co_a, R * ca + r * co_b
+        return (rs, rs_a, rs_b), (rc, rc_a, rc_b), (z, z_a, z_b)
+
     def derivatives(self, xi, eta, order: int = 2) -> np.ndarray:
         """b and its partial derivatives: shape B + (order+1, order+1, 3), entry [k, l] =
         ∂^(k+l) b / ∂ξ^k ∂η^l for k + l <= order (zero above), B the broadcast shape of
@@ -308,20 +423,82 @@ class BladeSurface:
         if order not in (0, 1, 2):
             raise GeometryError(f"derivative order must be 0, 1 or 2, got {order}")
         shape = np.broadcast_shapes(np.shape(xi), np.shape(eta))
+        out = np.zeros(shape + (order + 1, order + 1, 3))
+        if order == 1:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                comps = self._first_derivatives(xi, eta)
+            for k, (v, a, b) in enumerate(comps):
+                out[..., 0, 0, k], out[..., 1, 0, k], out[..., 0, 1, k] = v, a, b
+            return out
         with np.errstate(divide="ignore", invalid="ignore"):
             comps = self._jets(xi, eta, order)
-        out = np.zeros(shape + (order + 1, order + 1, 3))
         for k, jet in enumerate(comps):
             jet.stack_into(out, k, order)
+        return out
+
+    def _points(self, xi, eta):
+        """(x, y, z) of b(ξ, η) in plain numpy: the value part of :meth:`_jets`, the same
+        operations in the same order (so the same rounding), without the Jet bookkeeping
+        that dominates the cost of the many small evaluations in tip smoothing."""
+        xi = np.asarray(xi, dtype=np.float64)
+        if np.any(~np.isfinite(xi)):
+            raise GeometryError("xi contains NaN or infinite values")
+        eta = self._check_eta(eta)
+        h = self.hand
+        psi = np.mod(TWO_PI * xi if h > 0 else TWO_PI * (1.0 - xi), TWO_PI)
+        S = self.section.thickness(psi)
+        xj = 0.5 * (1.0 + np.cos(psi))
+        Q = self.radial(eta)
+        if self.chord_squared:
+            self._snap_tip(Q, eta)
+        q = Q[..., _CHORD]
+        c = np.sqrt(q) if self.chord_squared else q
+        P, th, iG, tc = Q[..., _PITCH], Q[..., _SKEW], Q[..., _RAKE], Q[..., _TC]
+        r = self.radius * eta
+        p = P * (1.0 / (TWO_PI * r))
+        cos_phi = 1.0 / np.sqrt(p * p + 1.0)
+        sin_phi = p * cos_phi
+        z_m = iG + th * P * (1.0 / TWO_PI)
+        if self.section.meanline is not None:
+            fc = Q[..., _FC]
+            m = fc * self.section.camber(xj, 0)
+            mp = fc * self.section.camber(xj, 1)
+            w = 1.0 / np.sqrt(mp * mp + 1.0)
+            Sw = tc * S * w
+            X = xj + -(Sw * mp)
+            Y = m + Sw
+        else:
+            X = xj
+            Y = tc * S
+        A = X + -0.5
+        ds = c * (-(A * cos_phi) + -(Y * sin_phi))
+        z = z_m + c * (A * sin_phi + -(Y * cos_phi))
+        ang = ds * (1.0 / r) + -th
+        rs = r * np.sin(ang)
+        return (-rs if h < 0 else rs), r * np.cos(ang), z
+
+    def mixed_derivatives(self, xi, eta) -> np.ndarray:
+        """b, b_ξ, b_η and b_ξη in the layout of :meth:`derivatives` (order 2) with the pure
+        second derivatives b_ξξ, b_ηη left 0. No jet product or function takes the mixed
+        part from the pure ones, so b_ξη is the one :meth:`derivatives` gives, bit for bit,
+        for about two thirds of the work (the marching surrogate of the cuts needs no more)."""
+        shape = np.broadcast_shapes(np.shape(xi), np.shape(eta))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            comps = self._jets(xi, eta, 2, pure=False)
+        out = np.zeros(shape + (3, 3, 3))
+        for k, jet in enumerate(comps):
+            jet.stack_into(out, k, 2)
+        out[..., 2, 0, :] = 0.0
+        out[..., 0, 2, :] = 0.0
         return out
 
     def evaluate(self, xi, eta) -> np.ndarray:
         """Points b(ξ, η): shape B + (3,), B the broadcast shape of ξ and η."""
         shape = np.broadcast_shapes(np.shape(xi), np.shape(eta))
-        comps = self._jets(xi, eta, 0)
+        comps = self._points(xi, eta)
         out = np.empty(shape + (3,))
-        for k, jet in enumerate(comps):
-            out[..., k] = jet.v
+        for k, v in enumerate(comps):
+            out[..., k] = v
         return out
 
     __call__ = evaluate

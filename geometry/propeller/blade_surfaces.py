@@ -38,6 +38,7 @@ from ..nurbs import BSplineSurface
 from ..nurbs.basis import basis_functions, find_span
 from ..nurbs.fitting import average_knots, greville_abscissae, interpolate_at
 from ..nurbs.skinning import transfinite_interpolation
+from .batch import curve_displacement, curve_parameters
 from .corners import blade_points
 
 DEGREE = 3
@@ -52,12 +53,13 @@ MAX_KNOTS = 4000
 
 def evaluate_curves(blade, curves, t) -> tuple[np.ndarray, np.ndarray]:
     """Points (K, n, 3) and blade parameters (K, n, 2) of K curves at the same t (n,),
-    with one evaluation of b for all of them."""
+    with one evaluation of b for all of them (and the curves' parameters in batches,
+    :mod:`.batch`)."""
     t = np.asarray(t, dtype=np.float64)
-    P = np.stack([c.parameters(t) for c in curves])
+    P = curve_parameters(curves, t)
     X = blade_points(blade, P)
     for k, c in enumerate(curves):
-        d = c.displacement(t)
+        d = curve_displacement(c, t, X[k])
         if d is not None:
             X[k] += d
     return X, P
@@ -104,16 +106,17 @@ def common_knots(blade, curves, tolerance: float, report: dict | None = None):
         rounds += 1
         U = _clamped(interior)
         g = greville_abscissae(U, DEGREE)
-        Xg, Pg = evaluate_curves(blade, curves, g)
-        C = fit_rows(U, Xg)
         breaks = np.unique(U)
         local = (np.arange(1, SAMPLES_PER_SPAN) / SAMPLES_PER_SPAN)
         ts = (breaks[:-1, None] + np.diff(breaks)[:, None] * local[None, :]).ravel()
         new = ~np.isin(ts, cache_t)
+        # one evaluation of the curves per round: the Greville abscissae and the new samples
+        Xa, Pa = evaluate_curves(blade, curves, np.concatenate([g, ts[new]]))
+        Xg, Pg = Xa[:, : g.size], Pa[:, : g.size]
+        C = fit_rows(U, Xg)
         if np.any(new):
-            Xn, _ = evaluate_curves(blade, curves, ts[new])
             cache_t = np.concatenate([cache_t, ts[new]])
-            cache_X = np.concatenate([cache_X, Xn], axis=1)
+            cache_X = np.concatenate([cache_X, Xa[:, g.size :]], axis=1)
         order = np.argsort(cache_t)
         cache_t, cache_X = cache_t[order], cache_X[:, order]
         F = cache_X[:, np.searchsorted(cache_t, ts)]

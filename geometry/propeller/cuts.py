@@ -47,6 +47,7 @@ so the cut crosses ξ = 0 continuously (Hally §6, last paragraph).
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -123,6 +124,27 @@ def cut_parameters(a: np.ndarray, m: int) -> np.ndarray:
     return t
 
 
+def _powers(s: np.ndarray) -> np.ndarray:
+    """(1, s, s², s³) as columns (n, 4) (filled in place: np.stack costs more than the
+    arithmetic at the march's sizes)."""
+    out = np.empty((s.size, 4))
+    out[:, 0] = 1.0
+    out[:, 1] = s
+    out[:, 2] = s * s
+    out[:, 3] = out[:, 2] * s
+    return out
+
+
+def _power_derivatives(s: np.ndarray) -> np.ndarray:
+    """(0, 1, 2s, 3s²) as columns (n, 4)."""
+    out = np.empty((s.size, 4))
+    out[:, 0] = 0.0
+    out[:, 1] = 1.0
+    out[:, 2] = 2 * s
+    out[:, 3] = 3 * s * s
+    return out
+
+
 def _fail(label, p, what):
     return GeometryError(
         f"blade cut {label}: {what} at ξ = {p[0]:.6g}, η = {p[1]:.6g} "
@@ -152,7 +174,7 @@ class BladeCache:
         wg = np.arange(n_w + 1) * self.hw
         wg_eval = np.maximum(wg, np.sqrt(ETA_TIP_GUARD))
         eta = np.clip(1.0 - wg_eval**2, blade.eta_min, 1.0 - ETA_TIP_GUARD)
-        D = blade.derivatives(xg[:-1, None], eta[None, :], 2)  # (n_xi, n_w+1, 3, 3, 3)
+        D = blade.mixed_derivatives(xg[:-1, None], eta[None, :])  # (n_xi, n_w+1, 3, 3, 3)
         D = np.concatenate([D, D[:1]], axis=0)
         dw = -2.0 * wg_eval[None, :, None]  # dη/dw
         F = D[..., 0, 0, :]
@@ -185,11 +207,7 @@ class BladeCache:
         j = np.minimum(y.astype(np.intp), self.n_w - 1)
         r = y - j
         C = self.coef[i, j]
-        one, zero = np.ones_like(s), np.zeros_like(s)
-        S = np.stack([one, s, s * s, s * s * s], axis=1)
-        dS = np.stack([zero, one, 2 * s, 3 * s * s], axis=1)
-        Rr = np.stack([one, r, r * r, r * r * r], axis=1)
-        dR = np.stack([zero, one, 2 * r, 3 * r * r], axis=1)
+        S, dS, Rr, dR = _powers(s), _power_derivatives(s), _powers(r), _power_derivatives(r)
         out = np.zeros((len(p), order + 1, order + 1, 3))
         CR = np.einsum("nabk,nb->nak", C, Rr)
         out[:, 0, 0] = np.einsum("na,nak->nk", S, CR)
@@ -198,6 +216,19 @@ class BladeCache:
             dw_deta = -0.5 / w
             out[:, 0, 1] = np.einsum("na,nabk,nb->nk", S, C, dR) * (dw_deta / self.hw)[:, None]
         return out
+
+
+_BLADE_CACHES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def blade_cache(blade) -> BladeCache:
+    """The :class:`BladeCache` of ``blade`` (default cells), built once per blade object:
+    a blade is immutable, and an edit of the smoothing settings marches new cuts on the
+    same blade (the operator reuses the model when the definition did not change)."""
+    cache = _BLADE_CACHES.get(blade)
+    if cache is None:
+        cache = _BLADE_CACHES[blade] = BladeCache(blade)
+    return cache
 
 
 def chart_derivatives(deriv, eta_min):
@@ -246,7 +277,9 @@ class _PlaneSolver:
         D = self.deriv(p, 1)
         n = self.n[idx]
         f = np.einsum("ij,ij->i", D[:, 0, 0] - self.x0[idx], n)
-        g = np.stack([np.einsum("ij,ij->i", D[:, 1, 0], n), np.einsum("ij,ij->i", D[:, 0, 1], n)], axis=1)
+        g = np.empty((len(f), 2))
+        g[:, 0] = np.einsum("ij,ij->i", D[:, 1, 0], n)
+        g[:, 1] = np.einsum("ij,ij->i", D[:, 0, 1], n)
         return f, g, D
 
     def newton_line(self, trial, m, idx):

@@ -41,7 +41,7 @@ from scipy.interpolate import make_interp_spline
 from ..errors import DefinitionError, GeometryError
 from .corners import Corners, HubCurve, ParameterCurve, SplineCurve, blade_points, hub_edge_curves, top_edge_curves
 from .cut_smoothing import GUARD_BOUND_FRACTION, SMOOTHING_ZONE_BOUND, smooth_cut
-from .cuts import BladeCache, march_cuts
+from .cuts import blade_cache, march_cuts
 
 #: Samples of each edge (in w = sqrt(1 - η)) for the arclength of c_LETE.
 LETE_SAMPLES = 1025
@@ -279,7 +279,7 @@ def build_edge_curves(blade, corners: Corners, sides: dict, settings, progress=N
     P2 = np.concatenate([c10, p_le[2], p_te[2]])
     if progress:
         progress("cuts", 0.0)
-    cache = BladeCache(blade)
+    cache = blade_cache(blade)
     all_cuts = march_cuts(blade, P0, P1, P2, labels=labels, cache=cache)
     tip_cuts = all_cuts[:N_t]
     le_cuts = all_cuts[N_t : N_t + len(ie)]

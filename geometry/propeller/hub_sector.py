@@ -63,6 +63,7 @@ outer loop alone gives G(ξ_hi) 2π/Z, the hub's area over Z, whatever p_h is.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+import functools
 from functools import cached_property
 
 import numpy as np
@@ -214,6 +215,15 @@ def nurbs_v_of_theta(theta, angle_range=PAPER_ANGLE_RANGE) -> np.ndarray:
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(GAUSS_POINTS)
 
 
+@functools.lru_cache(maxsize=8)
+def _leggauss(points: int):
+    """Gauss–Legendre nodes and weights, computed once per order (an eigenvalue solve)."""
+    x, w = np.polynomial.legendre.leggauss(points)
+    x.flags.writeable = False
+    w.flags.writeable = False
+    return x, w
+
+
 def _piece_edges(breaks, subdivisions: int) -> np.ndarray:
     b = np.unique(np.asarray(breaks, dtype=np.float64))
     t = np.linspace(0.0, 1.0, subdivisions + 1)
@@ -223,7 +233,7 @@ def _piece_edges(breaks, subdivisions: int) -> np.ndarray:
 def _gauss_pieces(breaks, subdivisions: int = GAUSS_SUBDIVISIONS, points: int = GAUSS_POINTS):
     """Nodes (n, N) and weights (n, N) of composite Gauss–Legendre (N = ``points``) on the
     pieces between ``breaks``, each cut into ``subdivisions`` equal parts."""
-    x, w = (_GL_X, _GL_W) if points == GAUSS_POINTS else np.polynomial.legendre.leggauss(points)
+    x, w = (_GL_X, _GL_W) if points == GAUSS_POINTS else _leggauss(points)
     edges = _piece_edges(breaks, subdivisions)
     lo, hi = edges[:-1], edges[1:]
     half = 0.5 * (hi - lo)

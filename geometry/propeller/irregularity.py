@@ -70,6 +70,22 @@ def curve_excess(t, X) -> float:
     return excess_curvature_variation((c @ (n / nn)) / np.linalg.norm(d1, axis=1) ** 3)
 
 
+def curve_excess_many(t, X) -> np.ndarray:
+    """:func:`curve_excess` of several curves sampled at the same t: X (m, n, 3) -> (m,),
+    with one interpolating spline for all of them (the same spline per curve)."""
+    X = np.asarray(X, dtype=np.float64)
+    S = make_interp_spline(t, np.moveaxis(X, 0, 1), k=3)
+    d1, d2 = np.moveaxis(S(t, 1), 1, 0), np.moveaxis(S(t, 2), 1, 0)
+    out = np.zeros(len(X))
+    for i in range(len(X)):
+        c = np.cross(d1[i], d2[i])
+        n = np.sum(c, axis=0)
+        nn = np.linalg.norm(n)
+        if nn > 0.0:
+            out[i] = excess_curvature_variation((c @ (n / nn)) / np.linalg.norm(d1[i], axis=1) ** 3)
+    return out
+
+
 def zone_cuts(curves) -> list[tuple[str, int, object, object]]:
     """(family, index, plain cut, smoothed curve) for every curve of the smoothing zone."""
     out = []
