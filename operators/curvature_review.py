@@ -59,11 +59,12 @@ from ..geometry.fairing.review_display import (
 )
 from ..geometry.fairing.surface_curvature import (
     DEFAULT_PERCENTILE,
+    DeviationSeeds,
     comb_scale,
     curvature_comb,
     diverging_colours,
     iso_line_comb,
-    signed_deviation,
+    signed_deviation_grid,
     symmetric_limits,
 )
 from ..geometry.nurbs import BSplineCurve, BSplineSurface
@@ -574,14 +575,14 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
     deviation = {}
     spacing = opt.spacing if opt.spacing > 0 else 1.2 * size
     if references:
-        ref_surfaces = [c[3] for c in maps if c[0] == "reference"]
+        # one KD-tree per reference surface; each map coarse to fine (signed_deviation_grid)
+        ref_seeds = [DeviationSeeds(c[3]) for c in maps if c[0] == "reference"]
         for c in maps:
             if c[0] != "source":
                 continue
-            pts = c[5].points.reshape(-1, 3)
             best = None
-            for ref in ref_surfaces:
-                d = signed_deviation(pts, ref)
+            for seeds in ref_seeds:
+                d = signed_deviation_grid(c[5].points, seeds.surface, seeds)
                 best = d if best is None else np.where(np.abs(d) < np.abs(best), d, best)
             deviation[(c[1].name, c[4])] = best.reshape(c[5].values.shape)
     times["comparison"] = time.perf_counter() - clock - sum(times.values())
