@@ -2,8 +2,8 @@
 15): the deviation maps of ``curvature_review(reference=...)``, one signed distance per
 map vertex of the five smoothed surfaces from the unsmoothed blade's display surface.
 
-Measured in the same run (CPU time of this process, one thread: the machine is shared,
-so wall time is also printed):
+Measured in the same run (CPU time of this process: the work is single-threaded numpy,
+and on a shared machine CPU time is the one-core figure; wall time is also printed):
 
 - the previous method (baseline): every map point from its nearest tessellation point
   by the safeguarded Newton iteration (zero-cosine tolerance 1e-8) and again from every
@@ -16,15 +16,11 @@ so wall time is also printed):
 """
 from __future__ import annotations
 
-import os
 import time
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from common import ROOT, load_checkout, report  # noqa: E402
+from common import ROOT, load_checkout, report
 
 REPEAT = 3
 #: The previous method's Newton tolerance and neighbours.
