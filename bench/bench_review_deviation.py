@@ -10,7 +10,10 @@ and on a shared machine CPU time is the one-core figure; wall time is also print
   neighbour on another branch (what ``signed_deviation`` did before);
 - ``signed_deviation_grid`` (what the review calls now): coarse points in full, the rest
   by Gauss–Newton from blended starts; its largest difference from the baseline;
-- the curvature maps of the same five surfaces (what the review computes anyway).
+- the curvature maps of the same five surfaces (what the review computes anyway);
+- with the bpy module: the whole review, ``review_objects(reference=...)`` of the
+  smoothed propeller's blade against the unsmoothed one's (what
+  ``bpy.ops.bladesmith.curvature_review(reference=...)`` runs), median of 3.
 
 ``figures()`` gives the table rows of ``make bench`` (bench/summary.py).
 """
@@ -98,18 +101,56 @@ def measure() -> dict:
             "max_difference_m": diff, "max_farther_m": farther, "max_deviation_m": largest}
 
 
+def measure_review() -> dict | None:
+    """CPU and wall time of the whole before/after review in Blender (None without bpy)."""
+    try:
+        import bpy
+    except ImportError:
+        return None
+    addon = load_checkout()
+    addon.register()
+    try:
+        from bladesmith.operators import curvature_review as cr
+
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        assert bpy.ops.bladesmith.add_propeller(preset="DTMB4119") == {"FINISHED"}
+        before = bpy.context.view_layer.objects.active
+        assert bpy.ops.bladesmith.add_propeller(preset="DTMB4119", smooth_tip=True) == {"FINISHED"}
+        after = bpy.context.view_layer.objects.active
+
+        def blade(root):
+            return [o for o in root.children_recursive
+                    if o.get("bladesmith_part") == "blade" and int(o.get("bladesmith_blade", 0)) == 0]
+
+        ref = bpy.data.collections.new("unsmoothed blade")
+        for o in blade(before):
+            ref.objects.link(o)
+        scene = bpy.context.scene
+        sources = blade(after)
+        _, cpu, wall = _cpu(lambda: cr.review_objects(scene, sources, reference=ref.name))
+        cr.clear_review(scene)
+        return {"review_cpu": cpu, "review_wall": wall}
+    finally:
+        addon.unregister()
+
+
 _CACHE: dict = {}
 
 
 def _measured() -> dict:
     if not _CACHE:
         _CACHE.update(measure())
+        _CACHE.update(measure_review() or {})
     return _CACHE
 
 
 def figures() -> list[dict]:
     m = _measured()
-    return [
+    rows = []
+    if "review_cpu" in m:
+        rows.append({"figure": "before/after review, DTMB 4119 smoothed vs unsmoothed (CPU)", "value": m["review_cpu"],
+                     "unit": "s", "baseline": "", "goal": "<= 2 s on one core"})
+    return rows + [
         {"figure": "review deviation maps, DTMB 4119 smoothed vs unsmoothed (CPU)", "value": m["new_cpu"] * 1e3,
          "unit": "ms", "baseline": "", "goal": "whole review <= 2 s"},
         {"figure": "review deviation maps: speed-up over the previous projection", "value": m["old_cpu"] / m["new_cpu"],
@@ -125,6 +166,9 @@ def main() -> dict:
         ("baseline: previous per-point projection", m["old_cpu"], f"wall {m['old_wall']:.2f} s"),
         ("the five curvature maps", m["maps_cpu"], f"wall {m['maps_wall']:.2f} s"),
     ])
+    if "review_cpu" in m:
+        print(f"  whole review_objects(reference=...) in Blender: {m['review_cpu']:.2f} s CPU "
+              f"({m['review_wall']:.2f} s wall)")
     print(f"  largest difference from the baseline {m['max_difference_m']:.3g} m, largest amount farther than "
           f"the baseline {m['max_farther_m']:.3g} m (largest deviation {m['max_deviation_m']:.3g} m)")
     return m
