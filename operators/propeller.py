@@ -268,11 +268,13 @@ def check_display_tolerance(value: float) -> float:
 def smoothing_settings(values: dict, diameter: float) -> dict:
     """Smoothing settings for geometry/ (lengths in metres): a plain dict keyed like the
     operator's properties."""
-    out = {name: values[name] for name in SMOOTHING_FIELDS if name not in DEFINING_POINT_KEYS}
+    # Blender keeps float32: take the decimal the user typed (0.1, not 0.10000000149), so
+    # the settings of the panel give the same geometry as the same settings given in R
+    out = {name: typed(values[name]) for name in SMOOTHING_FIELDS if name not in DEFINING_POINT_KEYS}
     for name in LENGTH_FRACTIONS:
-        out[name] = float(values[name]) * diameter
+        out[name] = typed(values[name]) * diameter
     out["filter_iterations"] = int(values["filter_iterations"])
-    out["defining_points"] = {key: float(values[key]) for key in DEFINING_POINT_KEYS}
+    out["defining_points"] = {key: typed(values[key]) for key in DEFINING_POINT_KEYS}
     return out
 
 
