@@ -33,6 +33,7 @@ reviewed objects, the selection and the active object are never touched.
 import json
 import math
 import os
+import pathlib
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -59,11 +60,12 @@ from ..geometry.fairing.review_display import (
 )
 from ..geometry.fairing.surface_curvature import (
     DEFAULT_PERCENTILE,
+    DeviationSeeds,
     comb_scale,
     curvature_comb,
     diverging_colours,
     iso_line_comb,
-    signed_deviation,
+    signed_deviation_grid,
     symmetric_limits,
 )
 from ..geometry.nurbs import BSplineCurve, BSplineSurface
@@ -574,14 +576,14 @@ def review_objects(scene, objects, options: ReviewOptions | None = None, **kwarg
     deviation = {}
     spacing = opt.spacing if opt.spacing > 0 else 1.2 * size
     if references:
-        ref_surfaces = [c[3] for c in maps if c[0] == "reference"]
+        # one KD-tree per reference surface; each map coarse to fine (signed_deviation_grid)
+        ref_seeds = [DeviationSeeds(c[3]) for c in maps if c[0] == "reference"]
         for c in maps:
             if c[0] != "source":
                 continue
-            pts = c[5].points.reshape(-1, 3)
             best = None
-            for ref in ref_surfaces:
-                d = signed_deviation(pts, ref)
+            for seeds in ref_seeds:
+                d = signed_deviation_grid(c[5].points, seeds.surface, seeds)
                 best = d if best is None else np.where(np.abs(d) < np.abs(best), d, best)
             deviation[(c[1].name, c[4])] = best.reshape(c[5].values.shape)
     times["comparison"] = time.perf_counter() - clock - sum(times.values())
@@ -884,14 +886,68 @@ def _root_of(obj):
     return obj
 
 
-def default_title(maps) -> str:
-    """The reviewed objects: their roots' names (a propeller, a wind blade, an impeller)."""
-    roots = []
+def _roots(maps) -> list:
+    out = []
     for m in maps:
         root = _root_of(_source_of(m))
-        if root is not None and root.name not in roots:
-            roots.append(root.name)
-    return ", ".join(roots[:4]) + (f" and {len(roots) - 4} more" if len(roots) > 4 else "")
+        if root is not None and root not in out:
+            out.append(root)
+    return out
+
+
+def _propeller_settings(root):
+    """The propeller property group of a Bladesmith propeller root, else None (without
+    touching the group of other objects: reading it would store an empty one on them)."""
+    if "bladesmith_propeller" not in root.keys():
+        return None
+    settings = getattr(root, "bladesmith_propeller", None)
+    return settings if settings is not None and settings.is_propeller else None
+
+
+def _described(root) -> tuple[str, str]:
+    """(name, state) of a root: a propeller's definition name with its preset, and
+    "tip smoothed" or "unsmoothed"; other roots: their name and ""."""
+    s = _propeller_settings(root)
+    if s is None:
+        return root.name, ""
+    from .propeller import PRESET_DIR
+
+    name = s.definition_name or root.name
+    source = pathlib.Path(s.source_path) if s.source_path else None
+    if source is not None and source.parent.resolve() == PRESET_DIR.resolve():
+        name += f" (preset {source.stem.upper()})"
+    return name, "tip smoothed" if s.smooth_tip else "unsmoothed"
+
+
+def default_title(maps, before=()) -> str:
+    """The reviewed objects: their roots' names (a propeller with its preset and whether
+    it is tip smoothed; a wind blade, an impeller); with ``before`` (the reference's
+    maps) "name: before <state>, after <state>"."""
+    after = [_described(r) for r in _roots(maps)]
+    if before:
+        ref = [_described(r) for r in _roots(before)]
+        names = list(dict.fromkeys(n for n, _ in ref + after))
+        state = lambda items: " + ".join(dict.fromkeys(st or n for n, st in items))  # noqa: E731
+        return f"{', '.join(names[:2])}: before {state(ref)}, after {state(after)}"
+    names = [n + (f", {st}" if st else "") for n, st in after]
+    return ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
+
+
+def smoothing_line(maps, before=()) -> str:
+    """The tip-smoothing settings (Hally 2013 symbols, lengths as fractions of D) of the
+    smoothed propellers among the reviewed roots (and the reference's), or ""."""
+    lines = []
+    for root in _roots(maps) + _roots(before):
+        s = _propeller_settings(root)
+        if s is None or not s.smooth_tip:
+            continue
+        text = (f"tip smoothing: delta_c {s.delta_c:g} D, d_t {s.tip_smoothing_distance:g} D, "
+                f"d_e {s.edge_smoothing_distance:g} D, s_j {s.transition_s:g}, alpha {s.filter_strength:g}, "
+                f"n {s.filter_iterations}, d {s.sample_spacing:g} D, h/d {s.edge_spacing_ratio:g}, "
+                f"tolerance {s.tolerance:g} D")
+        if text not in lines:
+            lines.append(text)
+    return "; ".join(lines)
 
 
 def _settings_line(settings: dict) -> str:
@@ -1244,10 +1300,15 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
                                         (LEGEND_BELOW + LEGEND_ABOVE) * width, 1.12 * width,
                                         np.array([0.5 * width, 0.5 * (LEGEND_ABOVE - LEGEND_BELOW) * width, 0.0])))
         clear_scene()
-        lines = [title or default_title(maps) or "curvature review", _settings_line(settings),
+        reference_maps = before if len(columns) > 1 else []
+        lines = [title or default_title(maps, reference_maps) or "curvature review", _settings_line(settings),
                  f"{settings.get('sign_convention', '')}" + ("; " if settings.get("sign_convention") else "")
                  + "grey lines: edges of the NURBS surfaces"]
+        smoothing = smoothing_line(maps, reference_maps)
+        if smoothing:
+            lines.insert(1, smoothing)
         text_h = 0.03
+        extra = len(lines) - 3  # the heading grows by a line for each line beyond three
         for n, body in enumerate(lines):
             mesh = _text_mesh(body, f"Bladesmith review heading {n}", text_h * (1.25 if n == 0 else 1.0))
             made_meshes.append(mesh)
@@ -1255,9 +1316,10 @@ def render_review_image(objects, filepath: str, *, panel_size: int = 480, legend
             obj.matrix_world = Matrix.Translation((0.0, -1.6 * text_h * n, 0.0))
             temp.collection.objects.link(obj)
             made_objects.append(obj)
-        heading_h = int(legend_height * 0.9)
+        content_h = (5.0 + 1.6 * extra) * text_h
+        heading_h = int(legend_height * 0.9 * content_h / (5.0 * text_h))
         heading = _render_strip(temp, cam, camera_data, folder, "heading", total_w, heading_h,
-                                5.0 * text_h, 1.12 * width, np.array([0.5 * width, -1.2 * text_h, 0.0]),
+                                content_h, 1.12 * width, np.array([0.5 * width, -(1.2 + 0.8 * extra) * text_h, 0.0]),
                                 left_align=True)
         body_rows = []
         for panels in rows:

@@ -40,8 +40,15 @@ edit while ``smooth_tip`` is on (about 0.33 s for DTMB 4119 on a quiet 2-core ma
 ``bench/bench_propeller_pipeline.py``), so live editing is meant for the unsmoothed blade.
 
 Units of the operator and panel settings: ``delta_c`` (Δc), ``tip_smoothing_distance``
-(d_t), ``edge_smoothing_distance`` (d_e), ``tolerance`` and ``display_tolerance`` are
-fractions of the diameter D; :func:`smoothing_settings` converts them to metres.
+(d_t), ``edge_smoothing_distance`` (d_e), ``tolerance``, ``sample_spacing`` (d) and
+``display_tolerance`` are fractions of the diameter D; :func:`smoothing_settings` converts
+them to metres. ``edge_spacing_ratio`` is h/d; ``xi_ll`` ... ``eta_te`` are the six
+defining points of Hally §4 in blade parameters.
+
+Definition files may carry a [smoothing] table (lengths in metres,
+:data:`~..geometry.propeller.definition.SMOOTHING_KEYS`): ``add_propeller`` takes from it
+every setting the call does not set, Load takes all of it, and Save writes every
+smoothing setting of the panel into it (:func:`smoothing_table`).
 """
 import math
 import pathlib
@@ -57,7 +64,8 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, St
 from ..geometry.errors import BladesmithError, DefinitionError, GeometryError
 from ..geometry.nurbs import BSplineSurface
 from ..geometry.propeller import BladeSurface, Hub, Propeller, PropellerModel, dumps_toml, smooth_blade
-from ..geometry.propeller.definition import RADIAL_FIELDS
+from ..geometry.propeller.corners import DefiningPoints
+from ..geometry.propeller.definition import DEFINING_POINT_KEYS, RADIAL_FIELDS, SMOOTHING_KEYS
 from ..geometry.propeller.display import DISPLAY_TOLERANCE_FRACTION, blade_display_surface, hub_surface
 from .progress import progress_callback
 from .nurbs_objects import PROPERTY_KEY, remove_object, write_surface
@@ -89,6 +97,9 @@ DEFAULT_TRANSITION_S = 0.75
 DEFAULT_FILTER_STRENGTH = 0.5
 DEFAULT_FILTER_ITERATIONS = 100
 DEFAULT_TOLERANCE = 1e-5
+#: d of Hally Eqs. 27-28 (the largest spacing of a cut's samples) and h/d of Eq. 28.
+DEFAULT_SAMPLE_SPACING = 0.005
+DEFAULT_EDGE_SPACING_RATIO = 0.01
 #: Above this, Eq. 29's fourth-difference filter amplifies the shortest wave
 #: (1 - 16β/6 < -1 for β > 0.75).
 MAX_FILTER_STRENGTH = 0.75
@@ -101,9 +112,25 @@ SMOOTHING_FIELDS = (
     "filter_strength",
     "filter_iterations",
     "tolerance",
+    "sample_spacing",
+    "edge_spacing_ratio",
+    *DEFINING_POINT_KEYS,
 )
 #: Smoothing settings given as fractions of D (converted to metres for geometry/).
-LENGTH_FRACTIONS = ("delta_c", "tip_smoothing_distance", "edge_smoothing_distance", "tolerance")
+LENGTH_FRACTIONS = ("delta_c", "tip_smoothing_distance", "edge_smoothing_distance", "tolerance", "sample_spacing")
+#: What the six defining points of Hally (2013) §4 (Fig. 4) are, for their tooltips.
+DEFINING_POINT_TEXT = {
+    "xi_ll": ("ξ_LL", "ξ of the lower-left corner of the pressure-side central surface, on the hub "
+              "(trailing-edge side), in (0, 0.25)"),
+    "xi_lr": ("ξ_LR", "ξ of the lower-right corner of the pressure-side central surface, on the hub "
+              "(leading-edge side), in (0.25, 0.5)"),
+    "xi_ul": ("ξ_UL", "ξ of the upper-left corner of the pressure-side central surface, in (0, 0.25)"),
+    "eta_ul": ("η_UL", "η (= r/R) of the upper-left corner of the pressure-side central surface"),
+    "xi_ur": ("ξ_UR", "ξ of the upper-right corner of the pressure-side central surface, in (0.25, 0.5)"),
+    "eta_ur": ("η_UR", "η (= r/R) of the upper-right corner of the pressure-side central surface"),
+    "eta_le": ("η_LE", "η (= r/R) of x_LE on the leading edge, where the tip surface begins"),
+    "eta_te": ("η_TE", "η (= r/R) of x_TE on the trailing edge, where the tip surface begins"),
+}
 
 #: Section names of the definition format and the panel's enum identifiers.
 THICKNESS_FORMS = {"NACA66MOD": "naca66mod", "NACA4": "naca4", "ELLIPTIC": "elliptic", "TABLE": "table"}
@@ -177,6 +204,23 @@ def smoothing_properties(smooth_default: bool = False, update=None) -> dict:
             description="Spline approximation tolerance of the smoothed surfaces, as a fraction of the diameter",
             default=DEFAULT_TOLERANCE, soft_min=1e-7, soft_max=1e-3, precision=7, step=0.001, **extra,
         ),
+        "sample_spacing": FloatProperty(
+            name="d / D",
+            description="d: largest spacing of the points sampled on a cut for the smoothing filter, as a fraction "
+            "of the diameter (Hally 2013 Eqs. 27-28)",
+            default=DEFAULT_SAMPLE_SPACING, soft_min=1e-4, soft_max=0.05, precision=5, step=0.01, **extra,
+        ),
+        "edge_spacing_ratio": FloatProperty(
+            name="h / d",
+            description="h/d: spacing of the cut samples at the leading or trailing edge over their largest "
+            "spacing d, in (0, 1) (Hally 2013 Eq. 28; Hally uses 1/100)",
+            default=DEFAULT_EDGE_SPACING_RATIO, soft_min=1e-3, soft_max=0.5, precision=4, step=0.01, **extra,
+        ),
+        **{key: FloatProperty(
+            name=label,
+            description=f"{text} (Hally 2013 §4, Fig. 4: the points that split the blade into five surfaces)",
+            default=getattr(DefiningPoints(), key), soft_min=0.0, soft_max=1.0, precision=4, step=0.1, **extra,
+        ) for key, (label, text) in DEFINING_POINT_TEXT.items()},
     }
 
 
@@ -207,6 +251,12 @@ def check_smoothing(values: dict) -> None:
         )
     if values["filter_iterations"] < 0:
         raise DefinitionError(f"must not be negative, got {values['filter_iterations']}", field="filter_iterations")
+    if values["sample_spacing"] <= 0:
+        raise DefinitionError(f"d must be a positive fraction of the diameter, got {values['sample_spacing']}",
+                              field="sample_spacing")
+    if not 0.0 < values["edge_spacing_ratio"] < 1.0:
+        raise DefinitionError(f"h/d must lie in (0, 1), got {values['edge_spacing_ratio']}", field="edge_spacing_ratio")
+    DefiningPoints(**{key: values[key] for key in DEFINING_POINT_KEYS}).validate()
 
 
 def check_display_tolerance(value: float) -> float:
@@ -218,10 +268,41 @@ def check_display_tolerance(value: float) -> float:
 def smoothing_settings(values: dict, diameter: float) -> dict:
     """Smoothing settings for geometry/ (lengths in metres): a plain dict keyed like the
     operator's properties."""
-    out = {name: values[name] for name in SMOOTHING_FIELDS}
+    # Blender keeps float32: take the decimal the user typed (0.1, not 0.10000000149), so
+    # the settings of the panel give the same geometry as the same settings given in R
+    out = {name: typed(values[name]) for name in SMOOTHING_FIELDS if name not in DEFINING_POINT_KEYS}
     for name in LENGTH_FRACTIONS:
-        out[name] = float(values[name]) * diameter
+        out[name] = typed(values[name]) * diameter
     out["filter_iterations"] = int(values["filter_iterations"])
+    out["defining_points"] = {key: typed(values[key]) for key in DEFINING_POINT_KEYS}
+    return out
+
+
+def smoothing_table(values: dict, diameter: float) -> dict:
+    """The [smoothing] table of a definition file (lengths in metres) from operator or
+    panel values (lengths as fractions of D; ``smooth_tip`` included when given)."""
+    out = {}
+    for name in SMOOTHING_KEYS:
+        if name not in values:
+            continue
+        value = values[name]
+        if name == "smooth_tip":
+            out[name] = bool(value)
+        elif name == "filter_iterations":
+            out[name] = int(value)
+        elif name in LENGTH_FRACTIONS:
+            out[name] = typed(value) * diameter
+        else:
+            out[name] = typed(value)
+    return out
+
+
+def file_smoothing_values(propeller: Propeller) -> dict:
+    """The [smoothing] table of a definition as operator values (lengths as fractions
+    of D): only the keys the file gives."""
+    out = {}
+    for name, value in (propeller.smoothing or {}).items():
+        out[name] = value / propeller.diameter if name in LENGTH_FRACTIONS else value
     return out
 
 
@@ -276,8 +357,9 @@ def updates_suspended() -> bool:
     return _suspended > 0
 
 
-def settings_to_dict(settings) -> dict:
-    """The definition (TOML layout) of a property group."""
+def settings_to_dict(settings, with_smoothing: bool = False) -> dict:
+    """The definition (TOML layout) of a property group; ``with_smoothing``: with the
+    [smoothing] table of all the smoothing settings (what Save writes)."""
     kind = settings.thickness_kind
     if kind == THICKNESS_FILE:
         thickness = bpy.path.abspath(settings.thickness_file) if settings.thickness_file else ""
@@ -293,7 +375,7 @@ def settings_to_dict(settings) -> dict:
     if settings.meanline == "TABLE":
         section["meanline_x_c"] = [typed(row.x_c) for row in settings.meanline_table]
         section["meanline_f"] = [typed(row.value) for row in settings.meanline_table]
-    return {
+    out = {
         "name": settings.definition_name,
         "blades": int(settings.blades),
         "diameter": typed(settings.diameter),
@@ -310,11 +392,16 @@ def settings_to_dict(settings) -> dict:
         },
         "radial": {name: [typed(getattr(row, name)) for row in settings.radial] for name in RADIAL_FIELDS},
     }
+    if with_smoothing:
+        values = smoothing_values(settings)
+        values["smooth_tip"] = settings.smooth_tip
+        out["smoothing"] = smoothing_table(values, out["diameter"])
+    return out
 
 
-def settings_to_definition(settings) -> Propeller:
+def settings_to_definition(settings, with_smoothing: bool = False) -> Propeller:
     """The validated definition of a property group (DefinitionError names the field)."""
-    return Propeller.from_dict(settings_to_dict(settings))
+    return Propeller.from_dict(settings_to_dict(settings, with_smoothing))
 
 
 def smoothing_values(source) -> dict:
@@ -791,11 +878,15 @@ class BLADESMITH_OT_add_propeller(bpy.types.Operator):
             smoothing = smoothing_values(self)
             smoothing["smooth_tip"] = self.smooth_tip
             smoothing["show_overlay"] = self.show_overlay
+            # the file's [smoothing] gives what this call does not set
+            for name, value in file_smoothing_values(propeller).items():
+                if not self.properties.is_property_set(name):
+                    smoothing[name] = value
             check_smoothing(smoothing)
             result = compute_display(
                 propeller,
                 display_tolerance=self.display_tolerance,
-                smooth_tip=self.smooth_tip,
+                smooth_tip=smoothing["smooth_tip"],
                 smoothing=smoothing,
                 progress=progress_callback(wm),
                 measure=True,
@@ -958,16 +1049,18 @@ class BLADESMITH_OT_load_propeller_definition(bpy.types.Operator):
         try:
             propeller = load_definition(self.filepath, "")
             smoothing = smoothing_values(settings)
+            smoothing["smooth_tip"] = settings.smooth_tip
+            smoothing.update(file_smoothing_values(propeller))  # the file's [smoothing] wins
             check_smoothing(smoothing)
             result = compute_display(
                 propeller,
                 display_tolerance=settings.display_tolerance,
-                smooth_tip=settings.smooth_tip,
+                smooth_tip=smoothing["smooth_tip"],
                 smoothing=smoothing,
                 progress=progress_callback(wm),
             )
             start = time.perf_counter()
-            definition_to_settings(settings, propeller)
+            definition_to_settings(settings, propeller, smoothing)
             show_result(root, result)
             store_status(settings, result, time.perf_counter() - start)
         except BladesmithError as exc:
@@ -979,7 +1072,7 @@ class BLADESMITH_OT_load_propeller_definition(bpy.types.Operator):
 
 
 class BLADESMITH_OT_save_propeller_definition(bpy.types.Operator):
-    """Save the active propeller's definition as TOML"""
+    """Save the active propeller's definition as TOML, with all its tip-smoothing settings"""
 
     bl_idname = "bladesmith.save_propeller_definition"
     bl_label = "Save Propeller Definition"
@@ -1006,7 +1099,8 @@ class BLADESMITH_OT_save_propeller_definition(bpy.types.Operator):
         if path.suffix.lower() != ".toml":
             path = path.with_suffix(".toml")
         try:
-            propeller = settings_to_definition(root.bladesmith_propeller)
+            # every smoothing setting goes into [smoothing] (lengths in metres)
+            propeller = settings_to_definition(root.bladesmith_propeller, with_smoothing=True)
             propeller.to_toml(path, header=f"{propeller.name}: written by Bladesmith")
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))

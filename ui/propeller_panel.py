@@ -298,8 +298,14 @@ class BLADESMITH_PT_propeller_smoothing_advanced(_Sub, bpy.types.Panel):
         col.use_property_split = True
         col.active = s.smooth_tip
         for name in ops.SMOOTHING_FIELDS:
-            if name not in SMOOTHING_UP_FRONT:
+            if name not in SMOOTHING_UP_FRONT and name not in ops.DEFINING_POINT_KEYS:
                 col.prop(s, name)
+        # the six defining points of Hally (2013) §4, Fig. 4 (blade parameters ξ, η = r/R)
+        col.label(text="Defining points (Hally Fig. 4)")
+        for row_keys in (("xi_ll", "xi_lr"), ("xi_ul", "eta_ul"), ("xi_ur", "eta_ur"), ("eta_le", "eta_te")):
+            row = col.row(align=True)
+            for name in row_keys:
+                row.prop(s, name)
 
 
 class BLADESMITH_PT_propeller_display(_Sub, bpy.types.Panel):

@@ -38,11 +38,32 @@ Format (every field is checked; messages name the file, the field and the value)
     t_c = [...]                   # maximum thickness / chord (> 0)
     f_c = [...]                   # maximum camber / chord (towards the suction side)
 
+    [smoothing]                   # optional: Hally (2013) tip smoothing, every key optional
+    smooth_tip = true             # the operator's default when the call does not set it
+    delta_c = 0.003048            # m, Δc (Eqs. 31, 49)
+    tip_smoothing_distance = 0.01524   # m, d_t (Eq. 30)
+    edge_smoothing_distance = 0.00762  # m, d_e (Eq. 30)
+    transition_s = 0.75           # s_j (Eq. 48), fractional arclength along c_LETE
+    filter_strength = 0.5         # α (Eq. 30), in (0, 0.75]
+    filter_iterations = 100       # n (Eq. 29)
+    tolerance = 3.048e-6          # m, spline accuracy (§9)
+    sample_spacing = 0.001524     # m, d, largest spacing of the cut samples (Eqs. 27-28)
+    edge_spacing_ratio = 0.01     # h/d (Eq. 28)
+    xi_ll = 0.1                   # the six defining points of §4 (Fig. 4) in blade parameters:
+    xi_lr = 0.4                   #   xi_ll, xi_lr on the hub; (xi_ul, eta_ul), (xi_ur, eta_ur)
+    xi_ul = 0.1                   #   the upper corners of the pressure-side central surface;
+    eta_ul = 0.9                  #   eta_le, eta_te of x_LE = b(1/2, eta_le), x_TE = b(0, eta_te)
+    xi_ur = 0.4
+    eta_ur = 0.9
+    eta_le = 0.9
+    eta_te = 0.9
+
 A CSV radial table has a header line with those column names ('#' lines are comments;
 ``t0_c`` and ``f0_c`` are accepted for ``t_c`` and ``f_c``).
 
 Every key is checked against the table's list of keys below (``_TOP_KEYS``,
-``_SECTION_KEYS``, ``_HUB_KEYS``, ``RADIAL_FIELDS``: the one place to add a key); an
+``_SECTION_KEYS``, ``_HUB_KEYS``, ``RADIAL_FIELDS``, ``SMOOTHING_KEYS``: the one place to
+add a key); an
 unknown key is refused with the nearest valid name. Counts and sizes are bounded by the
 ``MAX_*`` constants below (README "Limits of definitions"), named in the refusal.
 """
@@ -75,7 +96,19 @@ TIP_TOL = 1e-9
 #: fraction of the largest chord are refused when the definition is read.
 MAX_TIP_CHORD_RATIO = 0.3
 
-_TOP_KEYS = {"name", "blades", "diameter", "hub_diameter_ratio", "hand", "radial_table", "section", "hub", "radial"}
+_TOP_KEYS = {"name", "blades", "diameter", "hub_diameter_ratio", "hand", "radial_table", "section", "hub", "radial",
+             "smoothing"}
+#: [smoothing]: lengths (metres in the file), dimensionless settings, and the six defining
+#: points of Hally (2013) §4 (blade parameters); the names of
+#: :class:`~.smoothing.SmoothingSettings` and :class:`~.corners.DefiningPoints`.
+SMOOTHING_LENGTH_KEYS = ("delta_c", "tip_smoothing_distance", "edge_smoothing_distance", "tolerance", "sample_spacing")
+SMOOTHING_RATIO_KEYS = ("transition_s", "filter_strength", "edge_spacing_ratio")
+DEFINING_POINT_KEYS = ("xi_ll", "xi_lr", "xi_ul", "eta_ul", "xi_ur", "eta_ur", "eta_le", "eta_te")
+SMOOTHING_KEYS = ("smooth_tip", *SMOOTHING_LENGTH_KEYS, *SMOOTHING_RATIO_KEYS, "filter_iterations",
+                  *DEFINING_POINT_KEYS)
+#: Iterations n of the smoothing filter a file may ask for (the filter's cost grows with
+#: log n, see cut_smoothing.fourth_difference_filter; beyond this nothing changes).
+MAX_FILTER_ITERATIONS = 1_000_000
 _SECTION_KEYS = {"thickness", "meanline", "thickness_x_c", "thickness_t", "meanline_x_c", "meanline_f", "smooth_airfoil",
                  "smooth_passes"}
 #: Thickness names that are not airfoil files.
@@ -212,6 +245,8 @@ class Propeller:
     hub: HubDefinition
     radial: RadialDistribution
     source: str | None = field(default=None, compare=False)
+    #: The [smoothing] table (keys of SMOOTHING_KEYS, lengths in metres), or None.
+    smoothing: dict | None = field(default=None, hash=False)
 
     def __post_init__(self):
         p = self.source
@@ -235,6 +270,7 @@ class Propeller:
             )
         self._validate_section()
         self._validate_hub()
+        self._validate_smoothing()
 
     # -- validation -------------------------------------------------------------------
     def _validate_radial(self):
@@ -364,6 +400,49 @@ class Propeller:
                     path=p, field=f"hub.{end}_length",
                 )
 
+    def _validate_smoothing(self):
+        """[smoothing]: known keys and types here, ranges by :class:`SmoothingSettings`
+        (the one place they are defined), every refusal naming ``smoothing.<key>``."""
+        if self.smoothing is None:
+            return
+        p = self.source
+        sm = dict(table(self.smoothing, p, "smoothing"))
+        check_keys(sm, SMOOTHING_KEYS, p, "smoothing")
+        if "smooth_tip" in sm and not isinstance(sm["smooth_tip"], bool):
+            raise DefinitionError(f"expected true or false, got {_fmt(sm['smooth_tip'])}", path=p,
+                                  field="smoothing.smooth_tip")
+        for key in SMOOTHING_LENGTH_KEYS + SMOOTHING_RATIO_KEYS + DEFINING_POINT_KEYS:
+            if key in sm:
+                sm[key] = number(sm[key], p, f"smoothing.{key}")
+        if "filter_iterations" in sm:
+            sm["filter_iterations"] = number(sm["filter_iterations"], p, "smoothing.filter_iterations", lo=0,
+                                             hi=MAX_FILTER_ITERATIONS, integer=True)
+        object.__setattr__(self, "smoothing", sm)
+        self.smoothing_settings()  # the ranges
+
+    def smoothing_settings(self):
+        """The :class:`~.smoothing.SmoothingSettings` of the [smoothing] table (lengths
+        as fractions of R, defaults for keys not given); a bad value is a
+        DefinitionError naming ``smoothing.<key>`` and the file."""
+        from .corners import DefiningPoints
+        from .smoothing import SmoothingSettings
+
+        sm = self.smoothing or {}
+        values = {k: sm[k] for k in SMOOTHING_LENGTH_KEYS + SMOOTHING_RATIO_KEYS + ("filter_iterations",) if k in sm}
+        points = {k: sm[k] for k in DEFINING_POINT_KEYS if k in sm}
+        try:
+            values["defining_points"] = DefiningPoints(**points)
+            # the η of the points must lie above the hub (the blade's hub ratio is D's)
+            values["defining_points"].validate(_HubRatio(self.hub_diameter_ratio), "defining_points.")
+            return SmoothingSettings.from_metres(values, self.radius)
+        except DefinitionError as exc:
+            name = (exc.field or "").rsplit(".", 1)[-1]
+            message = exc.message
+            if name in SMOOTHING_LENGTH_KEYS:  # the settings count in R; the file in metres
+                bound = message.split(", got")[0]
+                message = f"{sm[name]!r} m is {sm[name] / self.radius:.4g} R, but it {bound} R (R = {self.radius:g} m)"
+            raise DefinitionError(message, path=self.source, field=f"smoothing.{name}" if name else "smoothing") from None
+
     # -- properties -----------------------------------------------------------------
     @property
     def base_dir(self) -> pathlib.Path | None:
@@ -444,6 +523,7 @@ class Propeller:
             hub=hub_def,
             radial=radial,
             source=p,
+            smoothing=data.get("smoothing"),
         )
 
     @classmethod
@@ -465,7 +545,7 @@ class Propeller:
             absolute = (self.base_dir / thickness).resolve()
             sec["thickness"] = os.path.relpath(absolute, relative_to).replace(os.sep, "/")
         sec = {k: list(v) if isinstance(v, tuple) else v for k, v in sec.items()}
-        return {
+        out = {
             "name": self.name,
             "blades": self.blades,
             "diameter": self.diameter,
@@ -475,6 +555,9 @@ class Propeller:
             "hub": dict(vars(self.hub)),
             "radial": {k: list(getattr(self.radial, k)) for k in RADIAL_FIELDS},
         }
+        if self.smoothing is not None:
+            out["smoothing"] = {k: self.smoothing[k] for k in SMOOTHING_KEYS if k in self.smoothing}
+        return out
 
     def to_toml(self, path, header: str = "") -> None:
         """Write the definition (atomically: temporary file, then os.replace)."""
@@ -484,6 +567,13 @@ class Propeller:
             atomic_write(path, text)
         except OSError as exc:
             raise DefinitionError(f"cannot write the definition: {exc}", path=str(path)) from exc
+
+
+@dataclass(frozen=True)
+class _HubRatio:
+    """What DefiningPoints.validate needs of a blade: its hub radius ratio."""
+
+    hub_ratio: float
 
 
 def read_radial_csv(name, base_dir=None, source=None) -> RadialDistribution:

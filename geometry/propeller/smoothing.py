@@ -55,6 +55,9 @@ DEVIATION_WORST = 6
 #: Samples of the tip surface per interval between its cuts, across them.
 DEVIATION_TIP_PER_CUT = 4
 DEVIATION_REFINE = 9
+#: The deviation report also starts from the other face (ξ -> 1 - ξ) where that face's
+#: point lies within this many times the distance found (a thin tip).
+MIRROR_REACH = 10.0
 #: Seed grid on b for projecting the tip surface (ξ by w = sqrt(1 - η)), from this far
 #: below the lowest η of the tip cuts.
 SEED_XI = 480
@@ -308,8 +311,31 @@ class BladeSeeds:
         return self.params[idx]
 
 
-def _project(blade, X, starts):
-    """Shortest closest-point distance over several start parameter sets."""
+def _mirrored(P) -> np.ndarray:
+    """The same chordwise place on the other face of the blade: ξ -> 1 - ξ (pressure <->
+    suction side, Hally §2; the leading edge ξ = 1/2 and the trailing edge 0 ≡ 1 map to
+    themselves)."""
+    Q = np.array(P, dtype=np.float64)
+    Q[:, 0] = 1.0 - Q[:, 0]
+    return Q
+
+
+def _project(blade, X, starts, mirror: bool = False):
+    """Shortest closest-point distance over several start parameter sets; with
+    ``mirror`` also from the other face of the best result (:func:`_mirrored`): near the
+    tip the blade is thinner than the seed grid is fine, and a start on the wrong face
+    ends in a local minimum there, which overstated the deviation (issue 15: +6.8 % on
+    the 72°-skew tip)."""
+    if mirror:
+        d, p = _project(blade, X, starts)
+        # only where the other face is near: thick parts cannot hold a nearer point there
+        Q = _mirrored(p)
+        other = np.flatnonzero(np.linalg.norm(blade_points(blade, Q) - X, axis=1) < MIRROR_REACH * d)
+        if other.size:
+            d2, p2 = project_to_blade(blade, X[other], Q[other], iterations=DEVIATION_ITERATIONS)
+            better = d2 < d[other]
+            d[other[better]], p[other[better]] = d2[better], p2[better]
+        return d, p
     best_d, best_p = None, None
     for P in starts:
         d, p = project_to_blade(blade, X, P, iterations=DEVIATION_ITERATIONS)
@@ -354,9 +380,9 @@ def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curve
                 P[k == kk] = curves.tip[kk].parameters(v[k == kk])
             if seeds is None:
                 seeds = BladeSeeds(blade, float(P[:, 1].min()) - SEED_ETA_MARGIN)
-            d, p = _project(blade, X, [P, seeds.nearest(X)])
+            d, p = _project(blade, X, [P, seeds.nearest(X)], mirror=True)
         else:
-            d, p = _project(blade, X, [param_surfaces[name].evaluate(u, v)])
+            d, p = _project(blade, X, [param_surfaces[name].evaluate(u, v)], mirror=name in zone_coord)
         if name in zone_coord:
             zone = _zone_mask(*zone_coord[name])
         else:
@@ -373,7 +399,7 @@ def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curve
             vv = np.clip(v[top, None] + dv.ravel()[None], 0.0, 1.0).ravel()
             Xr = S.evaluate(uu, vv)
             other = seeds.nearest(Xr) if name == "tip" else param_surfaces[name].evaluate(uu, vv)
-            dr, _ = _project(blade, Xr, [np.repeat(p[top], du.size, axis=0), other])
+            dr, _ = _project(blade, Xr, [np.repeat(p[top], du.size, axis=0), other], mirror=name in zone_coord)
             res[key] = float(max(d[idx].max(), dr.max()))
         out[name] = res
     out["max_outside"] = max(v["outside"] for v in out.values() if isinstance(v, dict))

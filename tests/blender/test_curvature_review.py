@@ -224,3 +224,42 @@ def test_included_hub_gets_its_own_panel_and_limits(scene, tmp_path):
     coloured = (panel[..., 0] - panel[..., 2]) > 0.2
     assert coloured.mean() > 0.1
     cr.clear_review(scene)
+
+
+def test_before_after_of_a_smoothed_propeller_names_preset_and_settings(scene):
+    """Issue 15: curvature_review(reference=...) of the tip-smoothed DTMB 4119 against the
+    unsmoothed one: every map vertex gets a deviation (coarse-to-fine projection), within
+    the smoothing's documented reach of the blade, and the image heading names the preset,
+    before/after and the smoothing settings."""
+    assert bpy.ops.bladesmith.add_propeller(preset="DTMB4119") == {"FINISHED"}
+    before = bpy.context.view_layer.objects.active
+    before.name = "DTMB 4119 unsmoothed"
+    assert bpy.ops.bladesmith.add_propeller(preset="DTMB4119", smooth_tip=True) == {"FINISHED"}
+    after = bpy.context.view_layer.objects.active
+
+    def blade(root):
+        return [o for o in root.children_recursive
+                if o.get("bladesmith_part") == "blade" and int(o.get("bladesmith_blade", 0)) == 0]
+
+    ref = bpy.data.collections.new("unsmoothed blade")
+    for o in blade(before):
+        ref.objects.link(o)
+    result = cr.review_objects(scene, blade(after), reference=ref.name, comb_lines=0, numbers=False)
+    coll = bpy.data.collections[cr.REVIEW_COLLECTION]
+    deviations = [o for o in coll.objects if (cr._role(o) or ("",))[0] == "deviation"]
+    assert len(deviations) == 5
+    radius = 0.1524
+    for o in deviations:
+        d = np.zeros(len(o.data.vertices), dtype=np.float32)
+        o.data.attributes[cr.VALUE_ATTRIBUTE].data.foreach_get("value", d)
+        assert np.all(np.isfinite(d)) and np.abs(d).max() < 5e-3 * radius  # SMOOTHING_ZONE_BOUND
+    assert result.settings["deviation_max"] > 0.0
+    maps = [o for o in coll.objects if cr._role(o) and cr._role(o)[:2] == ("map", "source")]
+    ref_maps = [o for o in coll.objects if cr._role(o) and cr._role(o)[:2] == ("map", "reference")]
+    assert cr.default_title(maps, ref_maps) == "DTMB 4119 (preset DTMB4119): before unsmoothed, after tip smoothed"
+    line = cr.smoothing_line(maps, ref_maps)
+    for text in ("delta_c 0.01 D", "d_t 0.05 D", "d_e 0.025 D", "s_j 0.75", "alpha 0.5", "n 100", "d 0.005 D",
+                 "h/d 0.01"):
+        assert text in line, (text, line)
+    assert cr.default_title(ref_maps) == "DTMB 4119 (preset DTMB4119), unsmoothed"
+    assert cr.smoothing_line(ref_maps) == ""

@@ -3,6 +3,7 @@ load/save operators, and what survives saving a .blend file."""
 import math
 import pathlib
 import tomllib
+from dataclasses import replace
 
 import bpy
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 
 from bladesmith.geometry.nurbs import BSplineSurface
 from bladesmith.geometry.propeller import Propeller, dumps_toml
+from bladesmith.geometry.propeller.definition import SMOOTHING_KEYS
 from bladesmith.geometry.propeller.display import blade_display_surface, hub_surface
 from bladesmith.operators import propeller as ops
 from bladesmith.operators.nurbs_objects import PROPERTY_KEY, stored_geometry
@@ -351,8 +353,9 @@ def test_save_and_load_definition(root, tmp_path):
     path = tmp_path / "saved.toml"
     assert bpy.ops.bladesmith.save_propeller_definition(filepath=str(path)) == {"FINISHED"}
     saved = Propeller.from_toml(path)
-    # float32 panel values come back as the decimals of the file
-    assert saved == Propeller.from_toml(PRESETS / "dtmb4119.toml")
+    # float32 panel values come back as the decimals of the file; Save adds [smoothing]
+    assert set(saved.smoothing) == set(SMOOTHING_KEYS)
+    assert replace(saved, smoothing=None) == Propeller.from_toml(PRESETS / "dtmb4119.toml")
     ids = _ids(root)
     assert bpy.ops.bladesmith.load_propeller_definition(filepath=str(PRESETS / "raked_demo.toml")) == {"FINISHED"}
     s = root.bladesmith_propeller
@@ -365,6 +368,77 @@ def test_save_and_load_definition(root, tmp_path):
     with pytest.raises(RuntimeError, match="diameter"):
         bpy.ops.bladesmith.load_propeller_definition(filepath=str(bad))
     assert (snapshot(), s.definition_toml) == before
+
+
+#: A value for every smoothing setting of the panel, none its default, valid for DTMB 4119
+#: (lengths as fractions of D).
+SMOOTHING_EDITS = {
+    "smooth_tip": True, "delta_c": 0.012, "tip_smoothing_distance": 0.045, "edge_smoothing_distance": 0.03,
+    "transition_s": 0.8, "filter_strength": 0.4, "filter_iterations": 80, "tolerance": 2e-5,
+    "sample_spacing": 0.004, "edge_spacing_ratio": 0.02, "xi_ll": 0.12, "xi_lr": 0.38, "xi_ul": 0.11,
+    "eta_ul": 0.88, "xi_ur": 0.39, "eta_ur": 0.89, "eta_le": 0.91, "eta_te": 0.92,
+}
+
+
+def _smoothing_of(settings) -> dict:
+    return {name: getattr(settings, name) for name in SMOOTHING_EDITS}
+
+
+def _same(a: dict, b: dict):
+    for name in SMOOTHING_EDITS:
+        assert a[name] == pytest.approx(b[name], rel=1e-6), (name, a[name], b[name])
+
+
+def test_save_writes_all_smoothing_settings_and_they_come_back(root, tmp_path):
+    """Issue 15: Save writes every smoothing setting (Δc, d_t, d_e, s_j, α, n, tolerance,
+    d, h/d, the six defining points of Hally Fig. 4, smooth_tip) into [smoothing], lengths
+    in metres; add_propeller(definition=...) and Load read all of them back."""
+    assert set(SMOOTHING_EDITS) == set(ops.SMOOTHING_FIELDS) | {"smooth_tip"}
+    s = root.bladesmith_propeller
+    with ops.suspended_updates():
+        for name, value in SMOOTHING_EDITS.items():
+            setattr(s, name, value)
+    bpy.context.view_layer.objects.active = root
+    path = tmp_path / "smoothing.toml"
+    assert bpy.ops.bladesmith.save_propeller_definition(filepath=str(path)) == {"FINISHED"}
+    table = tomllib.loads(path.read_text())["smoothing"]
+    assert set(table) == set(SMOOTHING_KEYS)
+    D = 0.3048
+    assert table["delta_c"] == pytest.approx(0.012 * D) and table["sample_spacing"] == pytest.approx(0.004 * D)
+    assert table["smooth_tip"] is True and table["filter_iterations"] == 80 and table["eta_te"] == 0.92
+    # a new propeller from the file: every setting as saved, and the pipeline ran with them
+    assert bpy.ops.bladesmith.add_propeller(definition=str(path)) == {"FINISHED"}
+    new = bpy.context.view_layer.objects.active
+    assert new != root and new.bladesmith_propeller.smooth_tip
+    _same(_smoothing_of(new.bladesmith_propeller), SMOOTHING_EDITS)
+    assert len({key[1] for key in parts(new) if key[0] == "blade"}) == 5
+    # what the call sets wins over the file
+    assert bpy.ops.bladesmith.add_propeller(definition=str(path), smooth_tip=False, xi_ll=0.13) == {"FINISHED"}
+    third = bpy.context.view_layer.objects.active.bladesmith_propeller
+    assert not third.smooth_tip and third.xi_ll == pytest.approx(0.13) and third.xi_lr == pytest.approx(0.38)
+    # Load into a propeller with other settings: the file's settings replace them
+    with ops.suspended_updates():
+        for name in SMOOTHING_EDITS:
+            root.bladesmith_propeller.property_unset(name)
+    assert root.bladesmith_propeller.xi_ll == pytest.approx(0.1)
+    bpy.context.view_layer.objects.active = root
+    assert bpy.ops.bladesmith.load_propeller_definition(filepath=str(path)) == {"FINISHED"}
+    _same(_smoothing_of(root.bladesmith_propeller), SMOOTHING_EDITS)
+
+
+def test_bad_smoothing_values_in_a_file_are_refused(scene, tmp_path):
+    data = preset_dict()
+    data["smoothing"] = {"xi_lr": 0.6}
+    path = write_definition(tmp_path, data)
+    before = snapshot()
+    with pytest.raises(RuntimeError, match=r"bad.toml.*smoothing.xi_lr.*0.6"):
+        bpy.ops.bladesmith.add_propeller(definition=str(path))
+    assert snapshot() == before
+    with pytest.raises(RuntimeError, match=r"field 'edge_spacing_ratio'.*1.5"):
+        bpy.ops.bladesmith.add_propeller(preset="dtmb4119", edge_spacing_ratio=1.5)
+    with pytest.raises(RuntimeError, match=r"field 'eta_le'.*1.2"):
+        bpy.ops.bladesmith.add_propeller(preset="dtmb4119", eta_le=1.2)
+    assert snapshot() == before
 
 
 def test_load_without_a_propeller_adds_one(scene):
