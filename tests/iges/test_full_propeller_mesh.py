@@ -35,7 +35,7 @@ gmsh = pytest.importorskip("gmsh")
 from bladesmith.geometry.propeller import Propeller, smooth_blade  # noqa: E402
 from bladesmith.geometry.propeller.definition import MAX_TIP_CHORD_RATIO  # noqa: E402
 from bladesmith.geometry.propeller.hub_sector import hub_sector, root_footprint_distance  # noqa: E402
-from bladesmith.iges.propeller import full_propeller_iges_entities, write_full_propeller_iges  # noqa: E402
+from bladesmith.iges.propeller import faces_per_blade, full_propeller_iges_entities, write_full_propeller_iges  # noqa: E402
 from bladesmith.iges.records import TrimmedSurface  # noqa: E402
 from occ_support import read_with_occ  # noqa: E402
 
@@ -166,7 +166,7 @@ def test_full_propeller_sews_into_one_valid_solid(case, tmp_path_factory):
     D = 2.0 * model.blade.radius
     occ, sewing, solid, volume = sewn_solid(path, D)
     assert occ.load_messages == [] and occ.transfer_messages == []
-    assert len(occ.faces) == 5 * model.blades + 1
+    assert len(occ.faces) == faces_per_blade() * model.blades + 1
     assert sewing.NbFreeEdges() == 0
     assert sewing.NbMultipleEdges() == 0
     assert solid is not None and BRepCheck_Analyzer(solid).IsValid()
@@ -298,7 +298,7 @@ def test_brep_186_is_one_valid_solid_with_the_sewn_volume(case, tmp_path_factory
     occ = read_with_occ(brep)
     assert occ.load_messages == [] and occ.transfer_messages == []
     assert occ.shape.ShapeType() == TopAbs_SOLID and BRepCheck_Analyzer(occ.shape).IsValid()
-    assert len(occ.faces) == 5 * model.blades + 1
+    assert len(occ.faces) == faces_per_blade() * model.blades + 1
     props = GProp_GProps()
     BRepGProp.VolumeProperties_s(occ.shape, props, VOLUME_EPS)
     _, _, _, sewn_volume = sewn_solid(path, D)
