@@ -34,7 +34,8 @@ import os
 import numpy as np
 
 from ..geometry.errors import GeometryError, IgesError
-from ..geometry.nurbs import BSplineSurface
+from ..geometry.nurbs import BSplineCurve, BSplineSurface, reverse, split
+from ..geometry.nurbs.operations import split_surface
 from .convert import curve_from_geometry, surface_from_geometry
 from .records import METRES_PER_UNIT, UNITS, CompositeCurve, CurveOnSurface, Line, SurfaceOfRevolution, TrimmedSurface
 from .writer import DEFAULT_RESOLUTION, write_iges
@@ -48,6 +49,21 @@ BLADE_SURFACES = (
     ("tip", "TIP"),
 )
 HUB_LABEL = "HUB"
+#: The blade surfaces that wrap round an edge of the blade, by label, with the parameter
+#: direction that runs along Hally's cuts round that edge: the leading- and trailing-edge
+#: surfaces (u) and the tip surface (v) (:mod:`~bladesmith.geometry.propeller.blade_surfaces`).
+#: Every cut passes through its edge point at the middle of its parameter range (Hally 2013
+#: §8, Eqs. 38-40; :mod:`~bladesmith.geometry.propeller.edge_curves`), where the surface
+#: turns through about 180 degrees within the edge radius (1e-4 to 1e-6 D).
+WRAPPED_SURFACES = {"LEADEDGE": "u", "TRAILEDG": "u", "TIP": "v"}
+#: Where a wrapped surface is split (``split_edges``), as a fraction of its domain along the
+#: cuts: the edge points.
+EDGE_SPLIT_FRACTION = 0.5
+#: Two split halves' boundaries that agree to this fraction of the blade's size are one
+#: shared edge whose control points differ by the round-off of knot insertion (c_11 runs
+#: the opposite way in the trailing-edge and tip surfaces, Hally 2013 §4 item 11, so the
+#: two insertions add the same points in the opposite order); they are made one array.
+SHARED_ROUNDOFF_FRACTION = 1e-12
 #: Metres per file unit for the unit names ``write_iges`` accepts.
 #: A blade surface's boundary is "on the hub" when it comes this close to it, as a fraction
 #: of the diameter (only used to refuse blade surfaces that do not belong to this hub).
@@ -188,7 +204,105 @@ def turned_blade(items, rotation) -> list:
     return out
 
 
-def full_propeller_geometry(model, blade, sector):
+def split_at_edges(items) -> list:
+    """(label, surface) with every wrapped surface (:data:`WRAPPED_SURFACES`) replaced by its
+    two halves, cut along the cuts' edge points (the iso-line at
+    :data:`EDGE_SPLIT_FRACTION` of its domain along the cuts) by knot insertion (NURBS Book
+    Alg. A5.1, :func:`~bladesmith.geometry.nurbs.operations.split_surface`): the same
+    surface exactly, and the two halves' common boundary is one control row of the refined
+    net, the same float64 numbers in both.
+
+    Why: each wrapped surface turns through ~180 degrees round an edge whose radius
+    (1e-4 D at a trailing edge, 1e-6 D on the smoothed tip) is far below any coarse mesh
+    size. A mesher that meshes the surface whole makes triangles that straddle the edge,
+    fold over (gmsh: "elements remain invalid", Delaunay falling back to MeshAdapt) and
+    give slivers or "PLC Error: A segment and a facet intersect" in 3-D. With an edge along
+    the blade's edge the mesher puts its nodes on it, and no triangle crosses it."""
+    out = []
+    for label, s in items:
+        direction = WRAPPED_SURFACES.get(label)
+        if direction is None:
+            out.append((label, s))
+            continue
+        a, b = s.domain_u if direction == "u" else s.domain_v
+        first, second = split_surface(s, direction, a + EDGE_SPLIT_FRACTION * (b - a))
+        out += [(label, first), (label, second)]
+    return _shared_boundaries(out)
+
+
+#: Index expressions of the four boundary rows of a control net (nu, nv, dim).
+_BOUNDARY_ROWS = ((slice(None), 0), (slice(None), -1), (0, slice(None)), (-1, slice(None)))
+
+
+def _shared_boundaries(items) -> list:
+    """Make boundaries that two surfaces share one float64 array: a boundary row of a
+    surface that matches no other surface's boundary exactly but lies within
+    :data:`SHARED_ROUNDOFF_FRACTION` of the size of the set from an earlier surface's
+    boundary (either way round) becomes a copy of that boundary."""
+    nets = [np.array(s.control_points) for _, s in items]
+    size = max(float(np.ptp(P.reshape(-1, P.shape[-1]), axis=0).max()) for P in nets)
+    tol = SHARED_ROUNDOFF_FRACTION * size
+    changed = set()
+    for j, Q in enumerate(nets):
+        for bj in _BOUNDARY_ROWS:
+            row = Q[bj]
+            exact = any(np.array_equal(row, P[bi]) or np.array_equal(row[::-1], P[bi])
+                        for i, P in enumerate(nets) if i != j for bi in _BOUNDARY_ROWS)
+            if exact:
+                continue
+            for i, P in enumerate(nets[:j]):
+                for bi in _BOUNDARY_ROWS:
+                    other = P[bi]
+                    if other.shape != row.shape:
+                        continue
+                    if np.max(np.abs(other - row)) <= tol:
+                        Q[bj] = other
+                    elif np.max(np.abs(other[::-1] - row)) <= tol:
+                        Q[bj] = other[::-1]
+                    else:
+                        continue
+                    changed.add(j)
+    out = []
+    for j, (label, s) in enumerate(items):
+        if j in changed:
+            s = BSplineSurface(s.degree_u, s.degree_v, s.knots_u, s.knots_v, nets[j], s.weights)
+        out.append((label, s))
+    return out
+
+
+def _root_row(surface: BSplineSurface) -> BSplineCurve:
+    """The v = 0 boundary of a blade surface: its first control row (a copy)."""
+    return BSplineCurve(surface.degree_u, surface.knots_u, np.array(surface.control_points[:, 0]),
+                        None if surface.weights is None else np.array(surface.weights[:, 0]))
+
+
+def _split_hole(pcurves, edges, whole, halves) -> tuple:
+    """The hole (pcurves, edges) with every root edge that is the v = 0 row of a split
+    surface (``whole[i]``, halves ``halves[i]``, both turned alike) replaced by the halves'
+    own v = 0 rows, and its parameter-space image cut at the same parameter (the image has
+    the root edge's parameter, :func:`~bladesmith.geometry.propeller.hub_sector.root_pcurves`)."""
+    out_p, out_e = [], []
+    for pc, edge in zip(pcurves, edges):
+        P = edge.control_points
+        for s, (first, second) in zip(whole, halves):
+            row = s.control_points[:, 0]
+            if np.array_equal(P, row):
+                cut = first.domain_u[1]
+                out_p += list(split(pc, cut))
+                out_e += [_root_row(first), _root_row(second)]
+                break
+            if np.array_equal(P[::-1], row):
+                a, b = edge.domain
+                out_p += list(split(pc, a + b - first.domain_u[1]))
+                out_e += [reverse(_root_row(second)), reverse(_root_row(first))]
+                break
+        else:
+            out_p.append(pc)
+            out_e.append(edge)
+    return tuple(out_p), tuple(out_e)
+
+
+def full_propeller_geometry(model, blade, sector, *, split_edges: bool = True):
     """The whole propeller as plain geometry: (blades, holes, angle_range).
 
     blades: Z lists of (label, surface), blade k the reference blade turned by 2πk/Z
@@ -196,6 +310,9 @@ def full_propeller_geometry(model, blade, sector):
     the whole hub, blade k's footprint the reference loop moved by 2πk/Z in θ and its 3-D
     curves the root rows of turned blade k. angle_range: a full turn with the seam between
     two blades (:func:`~bladesmith.geometry.propeller.hub_sector.full_hub_angle_range`).
+    split_edges: the leading-edge, trailing-edge and tip surfaces each as two halves cut
+    along the blade's edge (:func:`split_at_edges`), so 8 faces a blade instead of 5; the
+    root edges of the split surfaces are split alike.
     The sector must have been built from ``blade`` (its inner loop is the root edge)."""
     from ..geometry.propeller.hub_sector import full_hub_angle_range, oriented_root_edges, turned_pcurves
 
@@ -204,14 +321,46 @@ def full_propeller_geometry(model, blade, sector):
                             "(hub_sector(model, blade=...)), so the hub is trimmed by the blade root edge itself")
     items = _blade_surfaces(blade)
     _check_consistency(model, items, sector)
+    pieces = split_at_edges(items) if split_edges else items
+    wrapped = [label for label, _ in items if label in WRAPPED_SURFACES]
     names = dict((label, name) for name, label in BLADE_SURFACES)
     blades, holes = [], []
     for k in range(model.blades):
         turned = items if k == 0 else turned_blade(items, model.blade_rotation(k))
-        blades.append(turned)
         by_name = {names[label]: surface for label, surface in turned if label in names}
-        holes.append((turned_pcurves(sector, k), oriented_root_edges(sector, by_name)))
+        pcs, edges = turned_pcurves(sector, k), oriented_root_edges(sector, by_name)
+        if split_edges:
+            turned_pieces = pieces if k == 0 else turned_blade(pieces, model.blade_rotation(k))
+            whole = [s for (label, s) in turned if label in WRAPPED_SURFACES]
+            turned_halves = [[s for lab, s in turned_pieces if lab == label] for label in wrapped]
+            pcs, edges = _split_hole(pcs, edges, whole, turned_halves)
+            turned = turned_pieces
+        blades.append(turned)
+        holes.append((pcs, edges))
     return blades, holes, full_hub_angle_range(sector)
+
+
+def _face_labels(turned, k: int) -> list:
+    """IGES labels (8 characters at most) of blade k's faces: Hally's names for the
+    reference blade, the first six letters and the blade number for the others; the halves
+    of a split surface end in 1 and 2 before the blade number."""
+    counts = {}
+    for label, _ in turned:
+        counts[label] = counts.get(label, 0) + 1
+    out, seen = [], {}
+    for label, _ in turned:
+        stem = label[:6] if k else label
+        if counts[label] > 1:
+            seen[label] = seen.get(label, 0) + 1
+            stem = f"{label[:5]}{seen[label]}" if k else f"{label[:7]}{seen[label]}"
+        out.append(f"{stem}{k + 1:02d}"[-8:] if k else stem)
+    return out
+
+
+def faces_per_blade(split_edges: bool = True) -> int:
+    """Faces of one blade in the full-propeller export: Hally's five surfaces, or eight when
+    the wrapped surfaces are split along the blade's edges (:func:`split_at_edges`)."""
+    return len(BLADE_SURFACES) + (len(WRAPPED_SURFACES) if split_edges else 0)
 
 
 def _iso_uses(surface: BSplineSurface) -> list:
@@ -263,9 +412,10 @@ def _hub_outer_uses(sector, angle_range) -> list:
             (up.copy(), line((s0, a1), (s0, a0)), True)]
 
 
-def full_propeller_brep_entities(model, blade, hub_sector, units: str = "m") -> list:
+def full_propeller_brep_entities(model, blade, hub_sector, units: str = "m", *, split_edges: bool = True) -> list:
     """The whole propeller as ONE IGES 186 manifold solid B-rep (with 502/504/508/510/514,
-    :mod:`.brep`): the faces of :func:`full_propeller_iges_entities` (5Z untrimmed 128s
+    :mod:`.brep`): the faces of :func:`full_propeller_iges_entities` (8Z, or 5Z without
+    ``split_edges``, untrimmed 128s
     bounded by their own boundary curves, the full-turn 120 with the Z blade root edges as
     its loops and its own boundary as the outer one), every edge written once and used by
     two faces, all face normals pointing out of the propeller (blade S_u × S_v, hub
@@ -276,11 +426,11 @@ def full_propeller_brep_entities(model, blade, hub_sector, units: str = "m") -> 
     if key not in UNITS or key not in METRES_PER_UNIT:
         raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}")
     scale = 1.0 / METRES_PER_UNIT[key]
-    blades, holes, angle_range = full_propeller_geometry(model, blade, hub_sector)
+    blades, holes, angle_range = full_propeller_geometry(model, blade, hub_sector, split_edges=split_edges)
     faces = []
     for k, turned in enumerate(blades):
-        for label, s in turned:
-            record = surface_from_geometry(s, scale=scale, label=f"{label[:6]}{k + 1:02d}"[-8:] if k else label)
+        for name, (label, s) in zip(_face_labels(turned, k), turned):
+            record = surface_from_geometry(s, scale=scale, label=name)
             faces.append(FaceSpec(surface=record, loops=[_iso_uses(s)], outer=True))
     hub = _hub_surface(hub_sector, angle_range, scale)
     loops = [_hub_outer_uses(hub_sector, angle_range)]
@@ -289,8 +439,10 @@ def full_propeller_brep_entities(model, blade, hub_sector, units: str = "m") -> 
     return [solid_from_faces(faces, scale=scale, label="PROPELLR")]
 
 
-def full_propeller_iges_entities(model, blade, hub_sector, units: str = "m") -> list:
-    """IGES records of the whole propeller: Z blades of five 128 each, and the whole hub as
+def full_propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, split_edges: bool = True) -> list:
+    """IGES records of the whole propeller: Z blades of eight 128 each (Hally's five, the
+    leading-edge, trailing-edge and tip surfaces each split along the blade's edge,
+    :func:`split_at_edges`; five with ``split_edges=False``), and the whole hub as
     one 144 over a 120 turned a full turn, whose outer boundary is the boundary of its
     parameter domain (N1 = 0; the poles and the seam are the surface's own) and whose Z
     inner loops are the blade root edges (:func:`_root_loop`). Every blade face and the hub
@@ -300,11 +452,11 @@ def full_propeller_iges_entities(model, blade, hub_sector, units: str = "m") -> 
     if key not in UNITS or key not in METRES_PER_UNIT:
         raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}")
     scale = 1.0 / METRES_PER_UNIT[key]
-    blades, holes, angle_range = full_propeller_geometry(model, blade, hub_sector)
+    blades, holes, angle_range = full_propeller_geometry(model, blade, hub_sector, split_edges=split_edges)
     records = []
     for k, turned in enumerate(blades):
-        records += [surface_from_geometry(s, scale=scale, label=f"{label[:6]}{k + 1:02d}"[-8:] if k else label)
-                    for label, s in turned]
+        records += [surface_from_geometry(s, scale=scale, label=name)
+                    for name, (label, s) in zip(_face_labels(turned, k), turned)]
     surface = _hub_surface(hub_sector, angle_range, scale)
     inner = [_root_loop(surface, pc, edges, scale) for pc, edges in holes]
     records.append(TrimmedSurface(surface=surface, outer=None, inner=inner, label=HUB_LABEL))
@@ -312,14 +464,14 @@ def full_propeller_iges_entities(model, blade, hub_sector, units: str = "m") -> 
 
 
 def write_full_propeller_iges(path, model, blade, hub_sector, units: str = "m", *, resolution: float | None = None,
-                              brep: bool = False, **options) -> str:
+                              brep: bool = False, split_edges: bool = True, **options) -> str:
     """Write the whole propeller (:func:`full_propeller_iges_entities`, or with ``brep=True``
     the 186 solid of :func:`full_propeller_brep_entities`) to ``path`` atomically. Returns
-    the path."""
+    the path. split_edges: see :func:`split_at_edges`."""
     if brep:
-        records = full_propeller_brep_entities(model, blade, hub_sector, units)
+        records = full_propeller_brep_entities(model, blade, hub_sector, units, split_edges=split_edges)
     else:
-        records = full_propeller_iges_entities(model, blade, hub_sector, units)
+        records = full_propeller_iges_entities(model, blade, hub_sector, units, split_edges=split_edges)
     if resolution is None:
         resolution = DEFAULT_RESOLUTION / METRES_PER_UNIT[units.lower()]
     return write_iges(os.fspath(path), records, units=units, resolution=resolution, **options)

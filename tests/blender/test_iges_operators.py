@@ -277,8 +277,9 @@ def test_smoothed_propeller_exports_as_reference_blade_and_hub_sector(scene, tmp
 
 
 def test_full_propeller_option_writes_all_blades_and_the_whole_hub(scene, tmp_path):
-    """export_scene.iges(full_propeller=True): Z blades of five surfaces and one trimmed hub
-    with Z holes; OpenCASCADE reads it cleanly and its faces sew at 1e-7 D with no free edge."""
+    """export_scene.iges(full_propeller=True): Z blades of eight surfaces (Hally's five, the
+    LE, TE and tip surfaces split along the blade's edge) and one trimmed hub with Z holes;
+    OpenCASCADE reads it cleanly and its faces sew at 1e-7 D with no free edge."""
     from bladesmith.iges import BSplineSurface128, TrimmedSurface
 
     occ = _occ_support()
@@ -288,7 +289,7 @@ def test_full_propeller_option_writes_all_blades_and_the_whole_hub(scene, tmp_pa
     roots = read_iges(path).roots
     hubs = [r for r in roots if isinstance(r, TrimmedSurface)]
     assert len(hubs) == 1 and len(hubs[0].inner) == 3 and hubs[0].outer is None
-    assert sum(isinstance(r, BSplineSurface128) for r in roots) == 15
+    assert sum(isinstance(r, BSplineSurface128) for r in roots) == 24
     r = occ.read_with_occ(path)
     assert r.load_messages == [] and r.transfer_messages == []
     from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
@@ -297,12 +298,12 @@ def test_full_propeller_option_writes_all_blades_and_the_whole_hub(scene, tmp_pa
     for face in r.faces:
         sewing.Add(face)
     sewing.Perform()
-    assert len(r.faces) == 16 and sewing.NbFreeEdges() == 0
+    assert len(r.faces) == 25 and sewing.NbFreeEdges() == 0
     # and as one 186 solid
     solid_path = tmp_path / "solid.igs"
     assert bpy.ops.export_scene.iges(filepath=str(solid_path), full_propeller=True, brep_solid=True) == {"FINISHED"}
     r = occ.read_with_occ(solid_path)
-    assert r.load_messages == [] and r.transfer_messages == [] and len(r.faces) == 16
+    assert r.load_messages == [] and r.transfer_messages == [] and len(r.faces) == 25
     assert occ.is_valid(r.shape) and r.shape.ShapeType().name == "TopAbs_SOLID"
 
 
