@@ -239,8 +239,9 @@ def build_edge_curves(blade, corners: Corners, sides: dict, settings, progress=N
     s_cut = np.where(near, np.where(u_tip < 0.5, s_tip - gap, s_tip + gap), s_cut)
     if near[0] or near[-1]:
         raise DefinitionError("x_TE or x_LE is too close to the tip", field="eta_le" if near[-1] else "eta_te")
-    c9 = corners.ul[None] + u_tip[:, None] * (corners.ur - corners.ul)
-    c10 = corners.ul_s[None] + (1.0 - u_tip)[:, None] * (corners.ur_s - corners.ul_s)
+    top = top_edge_curves(corners, blade, sides)  # c_9, c_10 raised at their ends (corners.py)
+    c9 = top["c9"].parameters(u_tip)
+    c10 = top["c10"].parameters(1.0 - u_tip)
     p1_tip = lete.parameters(s_cut)
     c10 = c10 - np.where(p1_tip[:, :1] == 0.0, [[1.0, 0.0]], 0.0)  # periodic blade across the TE
     # --- edge families (Eqs. 34–35, 48)
@@ -323,7 +324,7 @@ def build_edge_curves(blade, corners: Corners, sides: dict, settings, progress=N
     trailing = list(te_low) + [c for c, _ in te_upper] + [te_top.reversed()]
     sm_le = np.array([False] * j + [f for _, f in le_upper] + [sm_tip[-1]])
     sm_te = np.array([False] * j + [f for _, f in te_upper] + [sm_tip[0]])
-    edges = {**hub, **top_edge_curves(corners), **sides, "c11": tip_curves[0], "c12": tip_curves[-1]}
+    edges = {**hub, **top, **sides, "c11": tip_curves[0], "c12": tip_curves[-1]}
     return EdgeCurveSet(
         lete=lete, s_le=s_le, s_te=s_te, tip=list(tip_curves), leading=leading, trailing=trailing, transition=j,
         u_edge=u, u_tip=u_tip, s_tip_cuts=s_cut, s_le_curves=s_le_c, s_te_curves=s_te_c,
