@@ -57,6 +57,7 @@ PRESETS = sorted((ROOT / "data" / "propellers").glob("*.toml"))
 IRREGULAR = sorted((ROOT / "tests" / "data" / "irregular_tips").glob("*.toml"))
 MM_PER_M = 1000.0
 SHARED_EDGE_TOL_D = 1e-12
+SEWING_TOL_D = 1e-7
 CURVATURE_POINTS = 30
 CURVATURE_MIN_D = 1e-3
 CURVATURE_MAX_D = 0.1
@@ -91,7 +92,7 @@ def built(path, tmp_path_factory):
         sector = hub_sector(model, blade=blade)
         out = tmp_path_factory.mktemp("faces") / f"{path.stem}.igs"
         write_propeller_iges(out, model, blade, sector, split_edges=True)
-        _BUILT[path] = SimpleNamespace(model=model, blade=blade, path=out, D=2.0 * model.blade.radius)
+        _BUILT[path] = SimpleNamespace(model=model, blade=blade, sector=sector, path=out, D=2.0 * model.blade.radius)
     return _BUILT[path]
 
 
@@ -175,6 +176,34 @@ def test_occ_reads_the_split_file_cleanly(path, tmp_path_factory):
     assert occ.load_messages == [] and occ.transfer_messages == []
     assert len(occ.faces) == len(SPLIT_SURFACE_NAMES) + 1
     assert all(is_valid(f) for f in occ.faces)
+
+
+@pytest.mark.parametrize("path", [pytest.param(p, id=p.stem) for p in PRESETS])
+def test_split_blade_faces_sew_into_one_shell(path, tmp_path_factory):
+    """The eight blade faces sew at 1e-7 D into one shell, open only at the blade root."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
+    from OCP.TopAbs import TopAbs_SHELL
+    from OCP.TopExp import TopExp_Explorer
+
+    c = built(path, tmp_path_factory)
+    occ = read_with_occ(c.path)
+    sewing = BRepBuilderAPI_Sewing(SEWING_TOL_D * c.D * MM_PER_M)
+    for face in occ.faces[: len(SPLIT_SURFACE_NAMES)]:
+        sewing.Add(face)
+    sewing.Perform()
+    shells = 0
+    explorer = TopExp_Explorer(sewing.SewedShape(), TopAbs_SHELL)
+    while explorer.More():
+        shells += 1
+        explorer.Next()
+    assert shells == 1 and sewing.NbMultipleEdges() == 0
+    R_hub = c.model.hub.radius
+    for i in range(1, sewing.NbFreeEdges() + 1):
+        curve = BRepAdaptor_Curve(sewing.FreeEdge(i))
+        t = np.linspace(curve.FirstParameter(), curve.LastParameter(), 9)
+        r = [np.hypot(curve.Value(x).X(), curve.Value(x).Y()) / MM_PER_M for x in t]
+        assert max(r) <= R_hub + max(SEWING_TOL_D * c.D, c.sector.tolerance), "a free edge away from the blade root"
 
 
 @pytest.mark.parametrize("sizing", ["curvature", "uniform"])
