@@ -320,7 +320,7 @@ def top_edge_curves(corners: Corners, blade=None, sides: dict | None = None) -> 
     side curves ``sides`` (c_5 ... c_8 of §5): the same lines bent near their ends so that
     the tip surface has no 180° corners (:func:`raised_top_edge`; a deviation from Hally,
     see :data:`TOP_EDGE_BEND_FRACTION`)."""
-    if blade is None:
+    if blade is None or not BEND_TOP_EDGES:
         return {"c9": LineCurve(corners.ul, corners.ur), "c10": LineCurve(corners.ul_s, corners.ur_s)}
     X = corners.points(blade)
     plane_c11 = (X["ul"], X["te"], X["ur_s"])  # Hally §4 item 11
@@ -350,6 +350,15 @@ def top_edge_curves(corners: Corners, blade=None, sides: dict | None = None) -> 
 #: corner angle each), and rejoins the straight line within this fraction, so the tip cuts
 #: in the middle (the smoothed ones, near the tip) are Hally's.
 TOP_EDGE_BEND_FRACTION = 0.2
+#: Bend c_9/c_10 at their ends (:func:`raised_top_edge`) when the blade is given to
+#: :func:`top_edge_curves`. Off by default: measured, the bend lifts the tip surface's
+#: corner min sin∠(S_u, S_v) from 5e-4–2e-3 to 0.05–0.40, but the gmsh 3-D mesh of the
+#: full DTMB 4119 (tests/iges/test_full_propeller_mesh.py, five-surface layout) then drops
+#: from min SICN 0.068 to 0.046 (0.027–0.034 with other bend lengths), its worst elements
+#: sitting on triangles that straddle the wrap-around faces' edges, not at the corners. With
+#: the edges split (blade_surfaces.split_at_edges) the 2-D meshes of every face have 0 invalid
+#: elements with or without the bend (tests/iges/test_propeller_face_mesh.py).
+BEND_TOP_EDGES = False
 #: Largest departure angle (degrees) of c_9 / c_10 from the straight line: below 90° the
 #: bent edge keeps moving along the chord (with :func:`_bump`, its chordwise speed stays
 #: above 1 - 0.25 (1 - cos θ) ... >= 1/2 of the line's at 60°), so the tip cuts through

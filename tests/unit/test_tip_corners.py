@@ -1,4 +1,5 @@
-"""Issue 15: the tip surface has no degenerate corners. With Hally's straight c_9/c_10
+"""Issue 15: the tip surface without degenerate corners (opt-in, corners.BEND_TOP_EDGES:
+see there why it is off by default). With Hally's straight c_9/c_10
 (Eqs. 6–7) the tip surface's boundary curves continue each other at its four corners
 (sin∠(S_u, S_v) 0.02-0.04 at the corners and 5e-4 to 9e-4 next to them, measured on every
 preset and irregular tip); c_9/c_10 now leave the corners at an angle
@@ -11,7 +12,8 @@ import pytest
 
 from bladesmith.geometry.errors import DefinitionError
 from bladesmith.geometry.propeller import Propeller
-from bladesmith.geometry.propeller.corners import LineCurve, RaisedLineCurve, TOP_EDGE_BEND_FRACTION
+from bladesmith.geometry.propeller import corners
+from bladesmith.geometry.propeller.corners import TOP_EDGE_BEND_FRACTION, LineCurve, RaisedLineCurve
 from bladesmith.geometry.propeller.edge_curves import tip_cut_positions
 from bladesmith.geometry.propeller.smoothing import smooth_blade
 
@@ -34,8 +36,11 @@ def _sines(S, u, v):
 
 @pytest.fixture(scope="module", params=CASES, ids=lambda p: p.stem)
 def smoothed(request):
+    """The blade smoothed with the top edges bent (corners.BEND_TOP_EDGES, off by default)."""
     model = Propeller.from_toml(request.param).build()
-    return model, smooth_blade(model, measure=False)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(corners, "BEND_TOP_EDGES", True)
+        return model, smooth_blade(model, measure=False)
 
 
 def test_tip_surface_corners_are_not_degenerate(smoothed):
@@ -72,3 +77,9 @@ def test_tip_cut_positions():
     assert min(0.44 - s[k - 1], s[k] - 0.44) >= 0.4 * 0.008
     with pytest.raises(DefinitionError):
         tip_cut_positions(0.5, 0.44, 0.66, 0.008)
+
+
+def test_default_top_edges_are_hallys_lines():
+    model = Propeller.from_toml(CASES[0]).build()
+    sb = smooth_blade(model, measure=False)
+    assert isinstance(sb.curves.edges["c9"], LineCurve) and isinstance(sb.curves.edges["c10"], LineCurve)
