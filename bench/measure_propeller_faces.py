@@ -10,7 +10,7 @@ for minutes). For every propeller preset and the irregular tips of tests/data/ir
   of triangles against the surface normal at their parametric centroid).
 
 Usage: python bench/measure_propeller_faces.py [--cases dtmb4119,raked_demo]
-       [--layouts five,split] [--sizings curvature,uniform]
+       [--layouts five,split] [--sizings curvature,uniform] [--bend] [--no-mesh]
 """
 from __future__ import annotations
 
@@ -104,8 +104,11 @@ def mesh(path, D: float, sizing: str):
         gmsh.finalize()
 
 
-def main(cases=None, layouts=("five", "split"), sizings=("curvature", "uniform")) -> None:
+def main(cases=None, layouts=("five", "split"), sizings=("curvature", "uniform"), bend: bool = False) -> None:
     load_checkout()
+    from bladesmith.geometry.propeller import corners as corner_module
+
+    corner_module.BEND_TOP_EDGES = bend
     from bladesmith.geometry.propeller import Propeller, smooth_blade
     from bladesmith.geometry.propeller.blade_surfaces import SPLIT_SHARED_EDGES, split_at_edges
     from bladesmith.geometry.propeller.hub_sector import hub_sector
@@ -142,5 +145,8 @@ if __name__ == "__main__":
     parser.add_argument("--cases", default="")
     parser.add_argument("--layouts", default="five,split")
     parser.add_argument("--sizings", default="curvature,uniform")
+    parser.add_argument("--bend", action="store_true", help="bend c_9/c_10 at the tip corners (BEND_TOP_EDGES)")
+    parser.add_argument("--no-mesh", action="store_true", help="geometry figures only")
     a = parser.parse_args()
-    main([c for c in a.cases.split(",") if c] or None, a.layouts.split(","), a.sizings.split(","))
+    main([c for c in a.cases.split(",") if c] or None, [] if a.no_mesh else a.layouts.split(","),
+         a.sizings.split(","), a.bend)
