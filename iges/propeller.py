@@ -477,7 +477,31 @@ def write_full_propeller_iges(path, model, blade, hub_sector, units: str = "m", 
     return write_iges(os.fspath(path), records, units=units, resolution=resolution, **options)
 
 
-def propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, model_curves: bool = False) -> list:
+#: IGES labels of the eight surfaces when the wrap-around surfaces are split at the edges
+#: (:func:`bladesmith.geometry.propeller.blade_surfaces.split_at_edges`).
+SPLIT_LABELS = {
+    "pressure_central": "PRESSURE", "suction_central": "SUCTION",
+    "leading_edge_pressure": "LEADEDGP", "leading_edge_suction": "LEADEDGS",
+    "trailing_edge_pressure": "TRAILEDP", "trailing_edge_suction": "TRAILEDS",
+    "tip_pressure": "TIPP", "tip_suction": "TIPS",
+}
+
+
+def _split_items(model, items) -> list:
+    """The five (label, surface) items as eight, split along the blade edges."""
+    from ..geometry.propeller.blade_surfaces import SPLIT_SURFACE_NAMES, split_at_edges
+
+    by_label = dict(items)
+    names = {label: name for name, label in BLADE_SURFACES}
+    if set(by_label) != set(names):
+        raise GeometryError("split_edges needs the five blade surfaces of the smoothing pipeline "
+                            f"({[n for n, _ in BLADE_SURFACES]})")
+    halves = split_at_edges({names[k]: v for k, v in by_label.items()}, int(np.sign(model.blade.hand)))
+    return [(SPLIT_LABELS[n], halves[n]) for n in SPLIT_SURFACE_NAMES]
+
+
+def propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, model_curves: bool = False,
+                            split_edges: bool = False) -> list:
     """IGES records of the reference blade and its trimmed hub sector (Hally 2013 §11).
 
     model: the :class:`~bladesmith.geometry.propeller.PropellerModel`. blade: a
@@ -485,6 +509,10 @@ def propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, model
     trailing_edge, tip), a dict with those keys, or a sequence of BSplineSurface.
     hub_sector: the :class:`~bladesmith.geometry.propeller.hub_sector.HubSector` of
     ``model``. units: the file's length unit; geometry (metres) is scaled to it.
+    split_edges: write the leading-edge, trailing-edge and tip surfaces as two surfaces
+    each, cut exactly along the blade edge, so the edge is a face boundary (meshers then
+    put nodes on it instead of folding triangles across its tiny radius near the tip;
+    see :func:`~bladesmith.geometry.propeller.blade_surfaces.split_at_edges`).
     Returns the root records: one 128 per blade surface, then the 144.
     Raises GeometryError/IgesError for inconsistent data.
     """
@@ -493,6 +521,8 @@ def propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, model
         raise IgesError(f"unknown units {units!r}; expected one of {sorted(UNITS)}")
     scale = 1.0 / METRES_PER_UNIT[key]
     items = _blade_surfaces(blade)
+    if split_edges:
+        items = _split_items(model, items)
     _check_consistency(model, items, hub_sector)
     records = [surface_from_geometry(s, scale=scale, label=label) for label, s in items]
     records.append(hub_records(hub_sector, scale=scale, model_curves=model_curves))
@@ -500,12 +530,13 @@ def propeller_iges_entities(model, blade, hub_sector, units: str = "m", *, model
 
 
 def write_propeller_iges(path, model, blade, hub_sector, units: str = "m", *, resolution: float | None = None,
-                         model_curves: bool = False, **options) -> str:
+                         model_curves: bool = False, split_edges: bool = False, **options) -> str:
     """Write the propeller's reference blade and hub sector to ``path`` (atomically, via
     :func:`bladesmith.iges.write_iges`, which validates every record first). resolution:
     Global field 19 in file units (default DEFAULT_RESOLUTION metres converted). Returns
     the path."""
-    records = propeller_iges_entities(model, blade, hub_sector, units, model_curves=model_curves)
+    records = propeller_iges_entities(model, blade, hub_sector, units, model_curves=model_curves,
+                                      split_edges=split_edges)
     if resolution is None:
         resolution = DEFAULT_RESOLUTION / METRES_PER_UNIT[units.lower()]
     return write_iges(os.fspath(path), records, units=units, resolution=resolution, **options)

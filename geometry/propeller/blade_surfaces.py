@@ -202,3 +202,104 @@ def central_surface(blade, bottom, top, left, right, knots_u, knots_v, edges) ->
             net[:, -1] = row
     return SurfacePair(BSplineSurface(DEGREE, DEGREE, knots_u, knots_v, net),
                        BSplineSurface(DEGREE, DEGREE, knots_u, knots_v, pnet))
+
+
+# ---------------------------------------------------------------------------------------
+# the wrap-around surfaces split at the edge
+# ---------------------------------------------------------------------------------------
+#: Names of the eight surfaces of :func:`split_at_edges`, in the order the IGES writer uses.
+SPLIT_SURFACE_NAMES = ("pressure_central", "suction_central", "leading_edge_pressure", "leading_edge_suction",
+                       "trailing_edge_pressure", "trailing_edge_suction", "tip_pressure", "tip_suction")
+
+
+def _with_net(surface: BSplineSurface, net: np.ndarray, direction: str) -> BSplineSurface:
+    """``surface`` with control net ``net`` and its ``direction`` knots mapped from
+    [0, 1/2] or [1/2, 1] to [0, 1] (2u or 2u - 1: exact in floating point)."""
+    def unit(U):
+        return 2.0 * U if U[-1] <= 0.5 else 2.0 * (U - 0.5)
+
+    U, V = surface.knots_u, surface.knots_v
+    U, V = (unit(U), V) if direction == "u" else (U, unit(V))
+    return BSplineSurface(surface.degree_u, surface.degree_v, U, V, net)
+
+
+def split_at_edges(surfaces: dict, hand: int = 1) -> dict:
+    """The five blade surfaces with the leading-edge, trailing-edge and tip surfaces each
+    cut in two along the blade edge (t = 1/2 of every curve around the edges, Hally Eqs. 24
+    and 47; 1/2 is a knot of the common sequence), exactly, by knot insertion
+    (:func:`~bladesmith.geometry.nurbs.operations.split_surface`): eight surfaces named
+    :data:`SPLIT_SURFACE_NAMES`. ``hand``: +1 right-handed (ξ < 1/2 is the pressure side),
+    -1 left-handed.
+
+    Why: the leading and trailing edges near the tip have radii of 1e-5 to 1e-4 D (the
+    section's edge radius scales with the vanishing chord). Inside a face such an edge is
+    resolved by no practical mesh size, and a mesher's triangles straddle it and fold
+    (gmsh: "elements remain invalid", 2-30 per face at curvature-adapted and uniform sizes).
+    As a face boundary the edge gets mesh nodes on it and no triangle crosses it.
+
+    Shared edges stay exact: the two halves of a surface share one control row (slices of
+    one net), and every row a half shares with a neighbour is copied from one array
+    (the central surfaces' rows from the five-surface set, the edge-surface tops from the
+    tip halves), never recomputed."""
+    from ..nurbs.operations import split_surface
+
+    le_a, le_b = split_surface(surfaces["leading_edge"], "u", 0.5)
+    te_a, te_b = split_surface(surfaces["trailing_edge"], "u", 0.5)
+    tip_a, tip_b = split_surface(surfaces["tip"], "v", 0.5)
+    pc, sc = surfaces["pressure_central"], surfaces["suction_central"]
+    if hand < 0:  # the pressure central surface lies at ξ > 1/2 (smoothing.smooth_blade)
+        pc, sc = sc, pc
+    # pc: u0 = TE surface's u1 row, u1 = LE surface's u0 row, v1 = tip's v0 column
+    # sc: u0 = LE surface's u1 row, u1 = TE surface's u0 row, v1 = tip's v1 column reversed
+    tip_a_net, tip_b_net = tip_a.control_points.copy(), tip_b.control_points.copy()
+    tip_a_net[:, 0] = pc.control_points[:, -1]
+    tip_b_net[:, -1] = sc.control_points[::-1, -1]
+    tip_b_net[:, 0] = tip_a_net[:, -1]
+    le_a_net, le_b_net = le_a.control_points.copy(), le_b.control_points.copy()
+    te_a_net, te_b_net = te_a.control_points.copy(), te_b.control_points.copy()
+    le_a_net[0], le_b_net[-1] = pc.control_points[-1], sc.control_points[0]
+    te_a_net[0], te_b_net[-1] = sc.control_points[-1], pc.control_points[0]
+    le_b_net[0] = le_a_net[-1]
+    te_b_net[0] = te_a_net[-1]
+    # tops: the LE surface's v1 row is the tip's u1 row (c_12); the TE surface's v1 row is
+    # the tip's u0 row (c_11) reversed; the halves of c_11 swap sides under the reversal
+    le_a_net[:, -1], le_b_net[:, -1] = tip_a_net[-1], tip_b_net[-1]
+    te_a_net[:, -1], te_b_net[:, -1] = tip_b_net[0][::-1], tip_a_net[0][::-1]
+    le_a, le_b = _with_net(le_a, le_a_net, "u"), _with_net(le_b, le_b_net, "u")
+    te_a, te_b = _with_net(te_a, te_a_net, "u"), _with_net(te_b, te_b_net, "u")
+    tip_a, tip_b = _with_net(tip_a, tip_a_net, "v"), _with_net(tip_b, tip_b_net, "v")
+    # first halves (ξ rising) of the LE surface and of the tip are on the pressure side of
+    # a right-handed blade; the TE surface runs suction -> pressure (its second half)
+    halves = {"leading_edge_pressure": le_a, "leading_edge_suction": le_b,
+              "trailing_edge_pressure": te_b, "trailing_edge_suction": te_a,
+              "tip_pressure": tip_a, "tip_suction": tip_b}
+    if hand < 0:
+        halves = {k.replace("pressure", "#").replace("suction", "pressure").replace("#", "suction"): v
+                  for k, v in halves.items()}
+    out = {"pressure_central": surfaces["pressure_central"], "suction_central": surfaces["suction_central"], **halves}
+    return {k: out[k] for k in SPLIT_SURFACE_NAMES}
+
+
+#: The shared edges of :func:`split_at_edges` for a right-handed blade, as
+#: (surface a, side a, surface b, side b, reversed) like smoothing.SHARED_EDGES.
+SPLIT_SHARED_EDGES = (
+    ("pressure_central", "u1", "leading_edge_pressure", "u0", False),
+    ("pressure_central", "u0", "trailing_edge_pressure", "u1", False),
+    ("suction_central", "u0", "leading_edge_suction", "u1", False),
+    ("suction_central", "u1", "trailing_edge_suction", "u0", False),
+    ("pressure_central", "v1", "tip_pressure", "v0", False),
+    ("suction_central", "v1", "tip_suction", "v1", True),
+    ("leading_edge_pressure", "u1", "leading_edge_suction", "u0", False),
+    ("trailing_edge_suction", "u1", "trailing_edge_pressure", "u0", False),
+    ("tip_pressure", "v1", "tip_suction", "v0", False),
+    ("leading_edge_pressure", "v1", "tip_pressure", "u1", False),
+    ("leading_edge_suction", "v1", "tip_suction", "u1", False),
+    ("trailing_edge_pressure", "v1", "tip_pressure", "u0", True),
+    ("trailing_edge_suction", "v1", "tip_suction", "u0", True),
+)
+
+
+def shared_rows(surface: BSplineSurface, side: str) -> np.ndarray:
+    """The control row of a surface along one side ('u0', 'u1', 'v0', 'v1')."""
+    P = surface.control_points
+    return {"u0": P[0], "u1": P[-1], "v0": P[:, 0], "v1": P[:, -1]}[side]

@@ -313,10 +313,142 @@ def hub_edge_curves(corners: Corners) -> dict[str, ParameterCurve]:
     }
 
 
-def top_edge_curves(corners: Corners) -> dict[str, ParameterCurve]:
-    """c_9 (x_UL -> x_UR) and c_10 (x_UL^(s) -> x_UR^(s)), straight in parameter space
-    (Hally Eqs. 6–7)."""
-    return {"c9": LineCurve(corners.ul, corners.ur), "c10": LineCurve(corners.ul_s, corners.ur_s)}
+def top_edge_curves(corners: Corners, blade=None, sides: dict | None = None) -> dict[str, ParameterCurve]:
+    """c_9 (x_UL -> x_UR) and c_10 (x_UL^(s) -> x_UR^(s)).
+
+    Without ``blade``: straight in parameter space (Hally Eqs. 6–7). With ``blade`` and the
+    side curves ``sides`` (c_5 ... c_8 of §5): the same lines bent near their ends so that
+    the tip surface has no 180° corners (:func:`raised_top_edge`; a deviation from Hally,
+    see :data:`TOP_EDGE_BEND_FRACTION`)."""
+    if blade is None or not BEND_TOP_EDGES:
+        return {"c9": LineCurve(corners.ul, corners.ur), "c10": LineCurve(corners.ul_s, corners.ur_s)}
+    X = corners.points(blade)
+    plane_c11 = (X["ul"], X["te"], X["ur_s"])  # Hally §4 item 11
+    plane_c12 = (X["ur"], X["le"], X["ul_s"])  # item 12
+    return {
+        "c9": raised_top_edge(blade, corners.ul, corners.ur, (plane_c11, sides["c5"]), (plane_c12, sides["c6"]), "c9"),
+        "c10": raised_top_edge(blade, corners.ul_s, corners.ur_s, (plane_c12, sides["c7"]), (plane_c11, sides["c8"]),
+                               "c10"),
+    }
+
+
+# ---------------------------------------------------------------------------------------
+# the tip surface's corners
+# ---------------------------------------------------------------------------------------
+#: Fraction of c_9 / c_10 (in its parameter) at each end over which it departs from
+#: Hally's straight line (Eqs. 6–7) and returns to it.
+#:
+#: Why: at x_UL, x_UR and their suction-side images three surfaces meet: the central surface
+#: (between c_5/c_6 and c_9), the edge surface (between c_5/c_6 and c_11/c_12) and the tip
+#: surface (between c_11/c_12 and c_9). With Hally's straight c_9 the central and edge
+#: surfaces take about 90° each, so the tip surface's corner is about 180°: its boundary
+#: curves c_11 and c_9 continue each other and S_u, S_v of the tip surface are parallel
+#: there (measured min sin∠(S_u, S_v) 5e-4 to 9e-4 next to the corners), which no
+#: re-parameterisation of a four-sided patch can cure. Here c_9 leaves each corner along
+#: the direction opposite to the bisector of the edge surface's corner, so the central and
+#: the tip surface share the remaining angle equally (180° minus half the edge surface's
+#: corner angle each), and rejoins the straight line within this fraction, so the tip cuts
+#: in the middle (the smoothed ones, near the tip) are Hally's.
+TOP_EDGE_BEND_FRACTION = 0.2
+#: Bend c_9/c_10 at their ends (:func:`raised_top_edge`) when the blade is given to
+#: :func:`top_edge_curves`. Off by default: measured, the bend lifts the tip surface's
+#: corner min sin∠(S_u, S_v) from 5e-4–2e-3 to 0.05–0.40, but the gmsh 3-D mesh of the
+#: full DTMB 4119 (tests/iges/test_full_propeller_mesh.py, five-surface layout) then drops
+#: from min SICN 0.068 to 0.046 (0.027–0.034 with other bend lengths), its worst elements
+#: sitting on triangles that straddle the wrap-around faces' edges, not at the corners. With
+#: the edges split (blade_surfaces.split_at_edges) the 2-D meshes of every face have 0 invalid
+#: elements with or without the bend (tests/iges/test_propeller_face_mesh.py).
+BEND_TOP_EDGES = False
+#: Largest departure angle (degrees) of c_9 / c_10 from the straight line: below 90° the
+#: bent edge keeps moving along the chord (with :func:`_bump`, its chordwise speed stays
+#: above 1 - 0.25 (1 - cos θ) ... >= 1/2 of the line's at 60°), so the tip cuts through
+#: its points stay in order and the tip surface cannot fold.
+TOP_EDGE_MAX_DEPARTURE_DEG = 60.0
+
+
+def _bump(x, f):
+    """B(x) = x (1 - x/f)³ on [0, f], 0 beyond: B(0) = 0, B'(0) = 1, and B, B', B'' vanish
+    at x = f (the bent curve rejoins the line C2)."""
+    x = np.asarray(x, dtype=np.float64)
+    return np.where(x < f, x * np.clip(1.0 - x / f, 0.0, None) ** 3, 0.0)
+
+
+@dataclass(frozen=True, eq=False)
+class RaisedLineCurve(ParameterCurve):
+    """The straight line of Hally Eqs. 6–7 bent at its ends:
+    p(t) = p_a + t (p_b - p_a) + B(t) e_a - B(1 - t) e_b, B = :func:`_bump` over ``bend``,
+    so p'(0) = (p_b - p_a) + e_a and p'(1) = (p_b - p_a) + e_b, and p is the line for
+    t in [bend, 1 - bend]."""
+
+    start: np.ndarray
+    end: np.ndarray
+    bend_start: np.ndarray
+    bend_end: np.ndarray
+    bend: float
+
+    def parameters(self, t):
+        t = np.asarray(t, dtype=np.float64)
+        a, b, f = np.asarray(self.start), np.asarray(self.end), self.bend
+        return (a + t[..., None] * (b - a) + _bump(t, f)[..., None] * np.asarray(self.bend_start)
+                - _bump(1.0 - t, f)[..., None] * np.asarray(self.bend_end))
+
+
+def _unit(v):
+    return v / np.linalg.norm(v)
+
+
+def _corner_tangent(blade, p, delta, plane, side, at_start: bool, name: str):
+    """At the corner p of a top edge (chord direction delta in parameters): the parameter
+    direction d with b_ξ d_ξ + b_η d_η = the unit tangent along which the top edge leaves
+    the corner (opposite to the bisector of the out-going tangents of the cut through
+    ``plane`` and of the side curve), and |a|, a = b_ξ delta_ξ + b_η delta_η."""
+    D = blade_derivatives(blade, np.asarray(p, dtype=np.float64)[None], 1)[0]
+    bx, be = D[1, 0], D[0, 1]
+    J = np.stack([bx, be], axis=1)  # (3, 2)
+    a = J @ delta
+    n_blade = np.cross(bx, be)
+    x0, x1, x2 = plane
+    n_plane = np.cross(x1 - x0, x1 - x2)  # Hally Eq. 15
+    cut = np.cross(n_blade, n_plane)
+    cut = _unit(cut if (cut @ a > 0) != at_start else -cut)  # away from the top edge
+    eps = 1e-6
+    q1, q0 = side.parameters(np.array([1.0, 1.0 - eps]))
+    dq = q1 - q0
+    dq[0] = np.mod(dq[0] + 0.5, 1.0) - 0.5
+    down = _unit(-(J @ dq))  # the side curve leaving the corner towards the hub
+    out = -(cut + down)
+    out = out - (out @ _unit(n_blade)) * _unit(n_blade)
+    if not np.linalg.norm(out) > 1e-3 * np.linalg.norm(cut + down + out):
+        raise GeometryError(f"{name}: the cut and the side curve leave the corner in opposite directions")
+    out = _unit(out)
+    along = _unit(a if at_start else -a)  # Hally's straight top edge leaving the corner
+    perp = _unit(np.cross(n_blade, along))
+    if perp @ be < 0.0:
+        perp = -perp  # towards the tip
+    phi = float(np.arctan2(out @ perp, out @ along))
+    if not phi > 0.0:
+        raise GeometryError(f"{name}: the edge surface's corner at ξ = {p[0]:.4g}, η = {p[1]:.4g} is reflex")
+    phi = min(phi, np.radians(TOP_EDGE_MAX_DEPARTURE_DEG))
+    out = np.cos(phi) * along + np.sin(phi) * perp
+    d = np.linalg.solve(J.T @ J, J.T @ out)
+    return d, float(np.linalg.norm(a))
+
+
+def raised_top_edge(blade, p_start, p_end, start_neighbours, end_neighbours, name: str = "top edge",
+                    bend: float = TOP_EDGE_BEND_FRACTION) -> RaisedLineCurve:
+    """c_9 or c_10 (Hally Eqs. 6–7) bent over ``bend`` of its length at each end so that it
+    leaves each corner opposite to the bisector of the edge surface's corner there
+    (:data:`TOP_EDGE_BEND_FRACTION`). ``*_neighbours``: (the three points of the cut's plane,
+    the side curve ending at that corner). The end speeds are kept (|b' | = |a|)."""
+    p_start, p_end = np.asarray(p_start, dtype=np.float64), np.asarray(p_end, dtype=np.float64)
+    delta = p_end - p_start
+    d0, a0 = _corner_tangent(blade, p_start, delta, *start_neighbours, True, name)
+    d1, a1 = _corner_tangent(blade, p_end, delta, *end_neighbours, False, name)
+    curve = RaisedLineCurve(p_start, p_end, a0 * d0 - delta, -a1 * d1 - delta, float(bend))
+    eta = curve.parameters(np.linspace(0.0, 1.0, 101))[:, 1]
+    if not eta.max() < 1.0 - ETA_TIP_GUARD:
+        raise GeometryError(f"{name}: bent to η = {eta.max():.4g}, beyond the tip; lower eta_ul / eta_ur")
+    return curve
 
 
 def check_corner_order(corners: Corners) -> None:

@@ -5,11 +5,10 @@ Eqs. 31–49).
   the hub, s the fractional arclength (total length L); its parameters p_LETE(s) have
   ξ = 0 on the trailing edge and ξ = 1/2 on the leading edge. The arclength is taken in
   w = sqrt(1 - η), in which the edges are smooth up to the closing tip.
-- Tip cuts (Eqs. 31–33): N_t = ceil(L (s_LE - s_TE) / Δc) + 1 cuts through
+- Tip cuts (Eqs. 31–33): about L (s_LE - s_TE) / Δc + 1 cuts, at most Δc apart, through
   x_0 = c_9(u), x_1 = c_LETE(s_TE + u (s_LE - s_TE)), x_2 = c_10(1 - u). Cut 1 is c_11 and
-  cut N_t is c_12. A cut whose edge point would fall within TIP_EXCLUSION·Δc of the tip
-  point (where the blade parameterisation is singular and every ξ gives the same point)
-  is moved to that distance from it (deviation; Hally does not discuss the case).
+  cut N_t is c_12. The tip point lies midway between two cuts (tip_cut_positions;
+  Hally does not discuss cuts at the singular tip).
 - Leading-edge curves (Eqs. 34–35, 49): N_LE = N_TE = ceil(max(1 - s_LE, s_TE) L / Δc) + 1;
   curve i >= j is the cut through x_0 = c_6(u_i), x_1 = c_LETE(1 - u_i (1 - s_LE)),
   x_2 = c_7(u_i); curve N_LE is c_12. Trailing edge likewise with x_0 = c_8(u_i),
@@ -45,8 +44,6 @@ from .cuts import blade_cache, march_cuts
 
 #: Samples of each edge (in w = sqrt(1 - η)) for the arclength of c_LETE.
 LETE_SAMPLES = 1025
-#: A cut's edge point keeps at least this many Δc from the tip point.
-TIP_EXCLUSION = 0.5
 #: Newton for f_u, f_v (Eq. 42): tolerance and iteration cap.
 TFI_NEWTON_TOL = 1e-14
 TFI_NEWTON_MAX_ITERATIONS = 40
@@ -100,6 +97,31 @@ class LeteCurve:
     def s_of(self, edge: str, eta: float) -> float:
         w = np.sqrt(1.0 - eta)
         return float(self._s_te(w) if edge == "te" else self._s_le(w))
+
+
+def tip_cut_positions(s_te: float, s_tip: float, s_le: float, spacing: float) -> np.ndarray:
+    """The s of the tip cuts' edge points x_1 (Hally Eqs. 31–33): from s_TE to s_LE, no two
+    more than ``spacing`` (Δc/L) apart, and the tip point s_tip midway between two cuts,
+    each side of it evenly spaced: n_a cuts s_TE + i δ_a (i < n_a) with
+    δ_a = (s_tip - s_TE)/(n_a - 1/2), likewise n_b cuts down from s_LE.
+
+    Hally spaces all N_t cuts evenly (Eq. 33) and does not discuss a cut that falls on or
+    next to the tip, where the blade parameterisation is singular. Moving such a cut
+    aside (the earlier rule: to Δc/2 from the tip) can put it next to its
+    neighbour (measured 6e-4 in s apart on steep_coarse), and the tip surface, which
+    interpolates its cuts at even v_j (Eq. 50), then folds between the two. Here the cuts
+    nearest the tip are at least spacing/2 · x/(x + 1) from it (x = the edge's length in
+    spacings) and the spacing never exceeds Δc."""
+    if not s_te < s_tip < s_le:
+        raise DefinitionError("x_TE and x_LE must lie below the tip on their edges",
+                              field="eta_te" if not s_te < s_tip else "eta_le")
+    n_a = int(np.ceil((s_tip - s_te) / spacing + 0.5))
+    n_b = int(np.ceil((s_le - s_tip) / spacing + 0.5))
+    d_a = (s_tip - s_te) / (n_a - 0.5)
+    d_b = (s_le - s_tip) / (n_b - 0.5)
+    te_side = s_te + d_a * np.arange(n_a)
+    le_side = (s_le - d_b * np.arange(n_b))[::-1]
+    return np.concatenate([te_side, le_side])
 
 
 @dataclass(frozen=True, eq=False)
@@ -224,7 +246,9 @@ def build_edge_curves(blade, corners: Corners, sides: dict, settings, progress=N
             "the smoothing range must end on the blade",
             field="tip_smoothing_distance",
         )
-    N_t = int(np.ceil(L * (s_le - s_te) / dc)) + 1  # Eq. 31
+    # Eq. 31, with the tip point midway between two cuts (see tip_cut_positions)
+    s_cut = tip_cut_positions(s_te, s_tip, s_le, dc / L)
+    N_t = s_cut.size
     N = int(np.ceil(max(1.0 - s_le, s_te) * L / dc)) + 1  # Eq. 49
     if min(N_t, N) < MIN_CURVES:
         raise DefinitionError(
@@ -232,15 +256,11 @@ def build_edge_curves(blade, corners: Corners, sides: dict, settings, progress=N
             field="delta_c",
         )
     # --- tip cuts (Eqs. 32–33)
-    u_tip = np.arange(N_t) / (N_t - 1)
-    s_cut = s_te + u_tip * (s_le - s_te)
-    gap = TIP_EXCLUSION * dc / L
-    near = np.abs(s_cut - s_tip) < gap
-    s_cut = np.where(near, np.where(u_tip < 0.5, s_tip - gap, s_tip + gap), s_cut)
-    if near[0] or near[-1]:
-        raise DefinitionError("x_TE or x_LE is too close to the tip", field="eta_le" if near[-1] else "eta_te")
-    c9 = corners.ul[None] + u_tip[:, None] * (corners.ur - corners.ul)
-    c10 = corners.ul_s[None] + (1.0 - u_tip)[:, None] * (corners.ur_s - corners.ul_s)
+    u_tip = (s_cut - s_te) / (s_le - s_te)  # Eq. 33 solved for u (Eq. 32: x_1 = c_LETE(s_te + u (s_le - s_te)))
+    u_tip[0], u_tip[-1] = 0.0, 1.0
+    top = top_edge_curves(corners, blade, sides)  # c_9, c_10 raised at their ends (corners.py)
+    c9 = top["c9"].parameters(u_tip)
+    c10 = top["c10"].parameters(1.0 - u_tip)
     p1_tip = lete.parameters(s_cut)
     c10 = c10 - np.where(p1_tip[:, :1] == 0.0, [[1.0, 0.0]], 0.0)  # periodic blade across the TE
     # --- edge families (Eqs. 34–35, 48)
@@ -323,7 +343,7 @@ def build_edge_curves(blade, corners: Corners, sides: dict, settings, progress=N
     trailing = list(te_low) + [c for c, _ in te_upper] + [te_top.reversed()]
     sm_le = np.array([False] * j + [f for _, f in le_upper] + [sm_tip[-1]])
     sm_te = np.array([False] * j + [f for _, f in te_upper] + [sm_tip[0]])
-    edges = {**hub, **top_edge_curves(corners), **sides, "c11": tip_curves[0], "c12": tip_curves[-1]}
+    edges = {**hub, **top, **sides, "c11": tip_curves[0], "c12": tip_curves[-1]}
     return EdgeCurveSet(
         lete=lete, s_le=s_le, s_te=s_te, tip=list(tip_curves), leading=leading, trailing=trailing, transition=j,
         u_edge=u, u_tip=u_tip, s_tip_cuts=s_cut, s_le_curves=s_le_c, s_te_curves=s_te_c,

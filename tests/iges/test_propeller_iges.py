@@ -268,17 +268,24 @@ GMSH_SIZE_MAX_D = 0.1
 
 @pytest.mark.parametrize("preset", PRESETS)
 def test_gmsh_imports_and_meshes_every_face(preset, tmp_path_factory):
+    """The smoothed blade written with its wrap-around surfaces split along the blade edges
+    (``split_edges=True``): in the five-surface layout the edges' tiny radii near the tip lie
+    inside the LE, TE and tip faces and gmsh folds triangles across them, 0 to 74 invalid
+    elements per face depending on the case and sizing (issue 15; all presets and the
+    irregular tips are in test_propeller_face_mesh.py)."""
     case = written(preset, "smoothed", tmp_path_factory)
     gmsh = pytest.importorskip("gmsh")
+    path = tmp_path_factory.mktemp("split") / f"{preset}_split.igs"
+    write_propeller_iges(path, case.model, case.blade, case.sector, split_edges=True)
     gmsh.initialize(readConfigFiles=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.logger.start()
         gmsh.model.add("propeller")
-        gmsh.model.occ.importShapes(str(case.path))
+        gmsh.model.occ.importShapes(str(path))
         gmsh.model.occ.synchronize()
         faces = gmsh.model.getEntities(2)
-        assert len(faces) == 6
+        assert len(faces) == 9
         D_mm = 2.0 * case.model.blade.radius * MM_PER_M
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", GMSH_CURVATURE_POINTS)
         gmsh.option.setNumber("Mesh.MeshSizeMin", GMSH_SIZE_MIN_D * D_mm)
