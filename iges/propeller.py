@@ -35,7 +35,6 @@ import numpy as np
 
 from ..geometry.errors import GeometryError, IgesError
 from ..geometry.nurbs import BSplineCurve, BSplineSurface, reverse, split
-from ..geometry.nurbs.operations import split_surface
 from .convert import curve_from_geometry, surface_from_geometry
 from .records import METRES_PER_UNIT, UNITS, CompositeCurve, CurveOnSurface, Line, SurfaceOfRevolution, TrimmedSurface
 from .writer import DEFAULT_RESOLUTION, write_iges
@@ -56,14 +55,6 @@ HUB_LABEL = "HUB"
 #: §8, Eqs. 38-40; :mod:`~bladesmith.geometry.propeller.edge_curves`), where the surface
 #: turns through about 180 degrees within the edge radius (1e-4 to 1e-6 D).
 WRAPPED_SURFACES = {"LEADEDGE": "u", "TRAILEDG": "u", "TIP": "v"}
-#: Where a wrapped surface is split (``split_edges``), as a fraction of its domain along the
-#: cuts: the edge points.
-EDGE_SPLIT_FRACTION = 0.5
-#: Two split halves' boundaries that agree to this fraction of the blade's size are one
-#: shared edge whose control points differ by the round-off of knot insertion (c_11 runs
-#: the opposite way in the trailing-edge and tip surfaces, Hally 2013 §4 item 11, so the
-#: two insertions add the same points in the opposite order); they are made one array.
-SHARED_ROUNDOFF_FRACTION = 1e-12
 #: Metres per file unit for the unit names ``write_iges`` accepts.
 #: A blade surface's boundary is "on the hub" when it comes this close to it, as a fraction
 #: of the diameter (only used to refuse blade surfaces that do not belong to this hub).
@@ -204,13 +195,16 @@ def turned_blade(items, rotation) -> list:
     return out
 
 
-def split_at_edges(items) -> list:
+def split_at_edges(items, hand: int = 1) -> list:
     """(label, surface) with every wrapped surface (:data:`WRAPPED_SURFACES`) replaced by its
-    two halves, cut along the cuts' edge points (the iso-line at
-    :data:`EDGE_SPLIT_FRACTION` of its domain along the cuts) by knot insertion (NURBS Book
-    Alg. A5.1, :func:`~bladesmith.geometry.nurbs.operations.split_surface`): the same
-    surface exactly, and the two halves' common boundary is one control row of the refined
-    net, the same float64 numbers in both.
+    two halves, in the order they follow each other along the cuts, both under the wrapped
+    surface's label and each over its own half of the surface's domain (so a half takes the
+    whole's parameters). The halves are those of
+    :func:`~bladesmith.geometry.propeller.blade_surfaces.split_at_edges`: cut at the edge
+    points (t = 1/2, Hally 2013 §8 Eqs. 38-40) by knot insertion, every row they share with
+    each other or a neighbour copied from one array, never recomputed. ``hand``: +1
+    right-handed, -1 left-handed (only names the halves there; the order here is found
+    from the rows themselves).
 
     Why: each wrapped surface turns through ~180 degrees round an edge whose radius
     (1e-4 D at a trailing edge, 1e-6 D on the smoothed tip) is far below any coarse mesh
@@ -218,56 +212,42 @@ def split_at_edges(items) -> list:
     fold over (gmsh: "elements remain invalid", Delaunay falling back to MeshAdapt) and
     give slivers or "PLC Error: A segment and a facet intersect" in 3-D. With an edge along
     the blade's edge the mesher puts its nodes on it, and no triangle crosses it."""
+    from ..geometry.propeller.blade_surfaces import split_at_edges as split_blade
+
+    names = {label: name for name, label in BLADE_SURFACES}
+    if sorted(label for label, _ in items) != sorted(names):
+        raise GeometryError("split_edges needs the five blade surfaces of the smoothing pipeline "
+                            f"({[n for n, _ in BLADE_SURFACES]}), got {[label for label, _ in items]}")
+    halves = split_blade({names[label]: s for label, s in items}, hand)
     out = []
-    for label, s in items:
-        direction = WRAPPED_SURFACES.get(label)
+    for label, whole in items:
+        name, direction = names[label], WRAPPED_SURFACES.get(label)
         if direction is None:
-            out.append((label, s))
+            out.append((label, halves[name]))
             continue
-        a, b = s.domain_u if direction == "u" else s.domain_v
-        first, second = split_surface(s, direction, a + EDGE_SPLIT_FRACTION * (b - a))
-        out += [(label, first), (label, second)]
-    return _shared_boundaries(out)
-
-
-#: Index expressions of the four boundary rows of a control net (nu, nv, dim).
-_BOUNDARY_ROWS = ((slice(None), 0), (slice(None), -1), (0, slice(None)), (-1, slice(None)))
-
-
-def _shared_boundaries(items) -> list:
-    """Make boundaries that two surfaces share one float64 array: a boundary row of a
-    surface that matches no other surface's boundary exactly but lies within
-    :data:`SHARED_ROUNDOFF_FRACTION` of the size of the set from an earlier surface's
-    boundary (either way round) becomes a copy of that boundary."""
-    nets = [np.array(s.control_points) for _, s in items]
-    size = max(float(np.ptp(P.reshape(-1, P.shape[-1]), axis=0).max()) for P in nets)
-    tol = SHARED_ROUNDOFF_FRACTION * size
-    changed = set()
-    for j, Q in enumerate(nets):
-        for bj in _BOUNDARY_ROWS:
-            row = Q[bj]
-            exact = any(np.array_equal(row, P[bi]) or np.array_equal(row[::-1], P[bi])
-                        for i, P in enumerate(nets) if i != j for bi in _BOUNDARY_ROWS)
-            if exact:
-                continue
-            for i, P in enumerate(nets[:j]):
-                for bi in _BOUNDARY_ROWS:
-                    other = P[bi]
-                    if other.shape != row.shape:
-                        continue
-                    if np.max(np.abs(other - row)) <= tol:
-                        Q[bj] = other
-                    elif np.max(np.abs(other[::-1] - row)) <= tol:
-                        Q[bj] = other[::-1]
-                    else:
-                        continue
-                    changed.add(j)
-    out = []
-    for j, (label, s) in enumerate(items):
-        if j in changed:
-            s = BSplineSurface(s.degree_u, s.degree_v, s.knots_u, s.knots_v, nets[j], s.weights)
-        out.append((label, s))
+        if (whole.domain_u if direction == "u" else whole.domain_v) != (0.0, 1.0):
+            raise GeometryError(f"blade surface {label}: split_edges needs the domain [0, 1] along the cuts")
+        start = (lambda S: S.control_points[0]) if direction == "u" else (lambda S: S.control_points[:, 0])
+        pair = [halves[f"{name}_pressure"], halves[f"{name}_suction"]]
+        if not np.array_equal(start(pair[0]), start(whole)):
+            pair.reverse()
+        if not np.array_equal(start(pair[0]), start(whole)):
+            raise GeometryError(f"blade surface {label}: neither half starts where the surface does")
+        out += [(label, _on_half(pair[0], direction, 0.0)), (label, _on_half(pair[1], direction, 0.5))]
     return out
+
+
+def _on_half(surface: BSplineSurface, direction: str, offset: float) -> BSplineSurface:
+    """A half of :func:`~bladesmith.geometry.propeller.blade_surfaces.split_at_edges`
+    (knots over [0, 1] along ``direction``) put back over [offset, offset + 1/2], the
+    part of the whole surface's domain it is: U/2 + offset, exact in floating point (the
+    inverse of that function's 2U and 2(U - 1/2)); the net is the same array."""
+    U, V = surface.knots_u, surface.knots_v
+    if direction == "u":
+        U = 0.5 * U + offset
+    else:
+        V = 0.5 * V + offset
+    return BSplineSurface(surface.degree_u, surface.degree_v, U, V, surface.control_points, surface.weights)
 
 
 def _root_row(surface: BSplineSurface) -> BSplineCurve:
@@ -321,7 +301,7 @@ def full_propeller_geometry(model, blade, sector, *, split_edges: bool = True):
                             "(hub_sector(model, blade=...)), so the hub is trimmed by the blade root edge itself")
     items = _blade_surfaces(blade)
     _check_consistency(model, items, sector)
-    pieces = split_at_edges(items) if split_edges else items
+    pieces = split_at_edges(items, int(np.sign(model.blade.hand))) if split_edges else items
     wrapped = [label for label, _ in items if label in WRAPPED_SURFACES]
     names = dict((label, name) for name, label in BLADE_SURFACES)
     blades, holes = [], []

@@ -249,6 +249,17 @@ def split_at_edges(surfaces: dict, hand: int = 1) -> dict:
     pc, sc = surfaces["pressure_central"], surfaces["suction_central"]
     if hand < 0:  # the pressure central surface lies at ξ > 1/2 (smoothing.smooth_blade)
         pc, sc = sc, pc
+    le, te, tip = surfaces["leading_edge"], surfaces["trailing_edge"], surfaces["tip"]
+    joins = {"LE u0 = central u1": (le.control_points[0], pc.control_points[-1]),
+             "LE u1 = central u0": (le.control_points[-1], sc.control_points[0]),
+             "TE u0 = central u1": (te.control_points[0], sc.control_points[-1]),
+             "TE u1 = central u0": (te.control_points[-1], pc.control_points[0]),
+             "tip v0 = central v1": (tip.control_points[:, 0], pc.control_points[:, -1]),
+             "tip v1 = central v1 reversed": (tip.control_points[:, -1], sc.control_points[::-1, -1])}
+    wrong = [k for k, (a, b) in joins.items() if a.shape != b.shape or not np.array_equal(a, b)]
+    if wrong:  # the rows copied below must be the shared ones: a wrong hand would swap sides
+        raise GeometryError(f"split_at_edges: the five surfaces do not share their edges as a "
+                            f"{'right' if hand > 0 else 'left'}-handed blade's do ({', '.join(wrong)})")
     # pc: u0 = TE surface's u1 row, u1 = LE surface's u0 row, v1 = tip's v0 column
     # sc: u0 = LE surface's u1 row, u1 = TE surface's u0 row, v1 = tip's v1 column reversed
     tip_a_net, tip_b_net = tip_a.control_points.copy(), tip_b.control_points.copy()

@@ -191,7 +191,7 @@ def test_edge_surfaces_are_split_along_the_edge_exactly(case, tmp_path_factory):
     model, blade, _, _ = built(case, tmp_path_factory)
     D = 2.0 * model.blade.radius
     items = _blade_surfaces(blade)
-    pieces = split_at_edges(items)
+    pieces = split_at_edges(items, int(np.sign(model.blade.hand)))
     assert len(pieces) == faces_per_blade()
     for label, whole in items:
         halves = [s for lab, s in pieces if lab == label]

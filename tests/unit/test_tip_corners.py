@@ -83,3 +83,19 @@ def test_default_top_edges_are_hallys_lines():
     model = Propeller.from_toml(CASES[0]).build()
     sb = smooth_blade(model, measure=False)
     assert isinstance(sb.curves.edges["c9"], LineCurve) and isinstance(sb.curves.edges["c10"], LineCurve)
+
+
+def test_split_at_edges_refuses_the_wrong_hand():
+    """The split copies each shared row from the neighbour it must equal; given the wrong
+    hand it would copy rows from the wrong side, so it checks the joins and refuses."""
+    from bladesmith.geometry.errors import GeometryError
+    from bladesmith.geometry.propeller.blade_surfaces import split_at_edges
+
+    for path in (ROOT / "data" / "propellers" / "raked_demo.toml", ROOT / "data" / "propellers" / "dtmb4119.toml"):
+        model = Propeller.from_toml(path).build()
+        hand = int(np.sign(model.blade.hand))
+        surfaces = smooth_blade(model, measure=False).named_surfaces
+        halves = split_at_edges(surfaces, hand)
+        assert len(halves) == 8
+        with pytest.raises(GeometryError, match="do not share their edges"):
+            split_at_edges(surfaces, -hand)
