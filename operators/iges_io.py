@@ -76,12 +76,15 @@ def _smoothed_propeller_roots(objects) -> list:
     return roots
 
 
-def _propeller_records(root, units: str, full_propeller: bool = False) -> list:
+def _propeller_records(root, units: str, full_propeller: bool = False, split_edges: bool = True) -> list:
     """Hally §11 records of a smoothed propeller: the reference blade's five surfaces (from
     their stored float64 data) and the hub sector of the model the root's definition makes,
     trimmed by the blade root edge itself. ``full_propeller``: all Z blades and the whole
     hub instead (:func:`..iges.propeller.full_propeller_iges_entities`), one closed shell;
-    ``"SOLID"``: the same faces as one IGES 186 manifold solid B-rep."""
+    ``"SOLID"``: the same faces as one IGES 186 manifold solid B-rep. ``split_edges``: the
+    leading-edge, trailing-edge and tip surfaces as two faces each, cut exactly along the
+    blade's edge (:func:`..geometry.propeller.blade_surfaces.split_at_edges`), so that a
+    mesher puts nodes on the edge instead of folding triangles across its tiny radius."""
     from ..geometry.propeller.hub_sector import hub_sector
     from ..geometry.propeller.smoothing import SURFACE_NAMES
     from ..iges.propeller import full_propeller_brep_entities, full_propeller_iges_entities, propeller_iges_entities
@@ -103,19 +106,23 @@ def _propeller_records(root, units: str, full_propeller: bool = False) -> list:
     tolerance = propeller.smoothing_settings(propeller.smoothing_values(settings), model.definition.diameter)["tolerance"]
     sector = hub_sector(model, tolerance=tolerance, blade=surfaces)
     if full_propeller == "SOLID":
-        return full_propeller_brep_entities(model, surfaces, sector, units.lower()), sector.warnings
+        return (full_propeller_brep_entities(model, surfaces, sector, units.lower(), split_edges=split_edges),
+                sector.warnings)
     if full_propeller:
-        return full_propeller_iges_entities(model, surfaces, sector, units.lower()), sector.warnings
-    return propeller_iges_entities(model, surfaces, sector, units.lower()), sector.warnings
+        return (full_propeller_iges_entities(model, surfaces, sector, units.lower(), split_edges=split_edges),
+                sector.warnings)
+    return propeller_iges_entities(model, surfaces, sector, units.lower(), split_edges=split_edges), sector.warnings
 
 
-def export_objects(objects, filepath: str, units: str = "M", progress=None, full_propeller: bool = False) -> dict:
+def export_objects(objects, filepath: str, units: str = "M", progress=None, full_propeller: bool = False,
+                   split_edges: bool = True) -> dict:
     """Write the NURBS of ``objects`` to ``filepath`` (atomically). Returns counts (and
     ``warnings``, a list of messages with figures).
 
     full_propeller: smoothed propellers go out whole (Z blades and the whole hub, one closed
     shell) instead of as Hally's reference blade and hub sector; "SOLID": as one IGES 186
-    manifold solid B-rep.
+    manifold solid B-rep. split_edges: their leading-edge, trailing-edge and tip surfaces
+    go out as two faces each, cut along the blade's edge (False: Hally's five surfaces).
 
     Raises :class:`BladesmithError` (nothing is written then) when an object cannot be
     expressed exactly or the data is inconsistent.
@@ -126,7 +133,7 @@ def export_objects(objects, filepath: str, units: str = "M", progress=None, full
     records, counts = [], {"surfaces": 0, "curves": 0, "objects": 0, "propellers": 0, "trimmed": 0, "warnings": []}
     roots = _smoothed_propeller_roots(objects)
     for root in roots:
-        found, warnings = _propeller_records(root, units, full_propeller)
+        found, warnings = _propeller_records(root, units, full_propeller, split_edges)
         counts["warnings"] += [f"propeller '{root.name}': {w}" for w in warnings]
         records.extend(found)
         counts["propellers"] += 1
@@ -274,6 +281,13 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
                     "closed shell (otherwise Hally's reference blade and hub sector)",
         default=False,
     )
+    split_edges: BoolProperty(
+        name="Split Edge Surfaces",
+        description="Write each smoothed propeller blade's leading-edge, trailing-edge and tip surfaces as two "
+                    "faces, cut exactly along the blade's edge, so that meshers put nodes on the edge instead of "
+                    "folding triangles across its tiny radius near the tip (off: Hally's five surfaces)",
+        default=True,
+    )
     brep_solid: BoolProperty(
         name="As Solid (186)",
         description="With Full Propeller: write the faces as one IGES 186 manifold solid B-rep "
@@ -288,7 +302,7 @@ class EXPORT_SCENE_OT_iges(bpy.types.Operator, ExportHelper):
         try:
             counts = export_objects(objects, self.filepath, self.units, progress_callback(wm),
                                     full_propeller="SOLID" if self.full_propeller and self.brep_solid
-                                    else self.full_propeller)
+                                    else self.full_propeller, split_edges=self.split_edges)
         except BladesmithError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}

@@ -248,8 +248,9 @@ def test_menus_are_registered(addon):
 
 
 def test_smoothed_propeller_exports_as_reference_blade_and_hub_sector(scene, tmp_path):
-    """Hally (2013) §11: the five reference-blade surfaces (exact, as smoothed) and the hub
-    sector as a trimmed surface, however many rotated copies the scene shows."""
+    """Hally (2013) §11 (``split_edges=False``): the five reference-blade surfaces (exact, as
+    smoothed) and the hub sector as a trimmed surface, however many rotated copies the scene
+    shows."""
     from bladesmith.geometry.propeller import Propeller, smooth_blade
     from bladesmith.iges import BSplineSurface128, TrimmedSurface
 
@@ -257,7 +258,7 @@ def test_smoothed_propeller_exports_as_reference_blade_and_hub_sector(scene, tmp
     rng = np.random.default_rng(9)
     surface_to_object(random_surface(rng, False), "Other")
     path = tmp_path / "prop.igs"
-    assert bpy.ops.export_scene.iges(filepath=str(path)) == {"FINISHED"}
+    assert bpy.ops.export_scene.iges(filepath=str(path), split_edges=False) == {"FINISHED"}
     model = read_iges(path)
     roots = model.roots
     assert sum(isinstance(r, TrimmedSurface) for r in roots) == 1
@@ -274,6 +275,42 @@ def test_smoothed_propeller_exports_as_reference_blade_and_hub_sector(scene, tmp
     reference = smooth_blade(definition.build(), measure=False)
     for r, s in zip(blades, reference.surfaces):
         assert np.abs(np.asarray(r.control_points) - s.control_points).max() < 1e-9 * definition.diameter
+
+
+def test_reference_export_splits_the_edge_surfaces_by_default(scene, tmp_path):
+    """The default export writes the LE, TE and tip surfaces as two faces each, cut along
+    the blade's edge (8 blade faces and the hub sector): each half is its shown surface
+    exactly over its half of the domain, and OpenCASCADE reads the file cleanly."""
+    from bladesmith.geometry.nurbs import BSplineSurface
+    from bladesmith.iges import BSplineSurface128, TrimmedSurface
+
+    occ = _occ_support()
+    assert bpy.ops.bladesmith.add_propeller(preset="dtmb4119", smooth_tip=True) == {"FINISHED"}
+    path = tmp_path / "split.igs"
+    assert bpy.ops.export_scene.iges(filepath=str(path)) == {"FINISHED"}
+    roots = read_iges(path).roots
+    assert sum(isinstance(r, TrimmedSurface) for r in roots) == 1
+    blades = [r for r in roots if isinstance(r, BSplineSurface128)]
+    assert sorted(r.label for r in blades) == sorted(
+        ["PRESSURE", "SUCTION", "LEADEDGP", "LEADEDGS", "TRAILEDP", "TRAILEDS", "TIPP", "TIPS"])
+    shown = {o["bladesmith_patch"]: object_to_geometry(o)[0] for o in scene.objects
+             if o.get("bladesmith_part") == "blade" and o.get("bladesmith_blade", 0) == 0}
+    wrapped = [shown[k] for k in sorted(shown)][2:]  # LE, TE, tip (smoothing.SURFACE_NAMES order)
+    t = np.linspace(0.0, 1.0, 21)[:, None]
+    s = np.linspace(0.0, 1.0, 17)[None, :]
+    # DTMB 4119 is right-handed: the first half along the cuts is the LE's and tip's pressure
+    # side and the TE's suction side (the TE surface runs suction -> pressure)
+    pairs = (("LEADEDGP", "LEADEDGS", "u"), ("TRAILEDS", "TRAILEDP", "u"), ("TIPP", "TIPS", "v"))
+    for whole, (first, second, direction) in zip(wrapped, pairs):
+        for label, offset in ((first, 0.0), (second, 0.5)):
+            (r,) = [r for r in blades if r.label == label]
+            half = BSplineSurface(r.degree_u, r.degree_v, np.asarray(r.knots_u), np.asarray(r.knots_v),
+                                  np.asarray(r.control_points))
+            u, v = (offset + 0.5 * t, s) if direction == "u" else (s.T, offset + 0.5 * t.T)
+            h = half.evaluate(t, s) if direction == "u" else half.evaluate(s.T, t.T)
+            assert np.abs(h - whole.evaluate(u, v)).max() < 1e-12 * 0.3048, label
+    r = occ.read_with_occ(path)
+    assert r.load_messages == [] and r.transfer_messages == [] and len(r.faces) == 9
 
 
 def test_full_propeller_option_writes_all_blades_and_the_whole_hub(scene, tmp_path):
