@@ -351,9 +351,11 @@ def test_signed_deviation_vectorised_matches_the_general_projection():
     ref = blade_display_surface(model.blade, 2e-4 * model.blade.radius).surface
     seeds = sc.DeviationSeeds(ref)
     R = model.blade.radius
-    # the tip: next to the display surface's collapsed tip edge the general projection
-    # finds points nearer by up to 1.2e-9 m (8e-9 R) where the deviation is ~5e-7 m
-    for name, tol in (("trailing_edge", 1e-9), ("leading_edge", 1e-9), ("tip", 1e-8)):
+    # the tip: next to the display surface's collapsed tip edge the seeded projection can
+    # stop in a local minimum: the general one finds points nearer by up to 6.4e-9 m
+    # (4.2e-8 R; 1.2e-9 m before the tip cuts moved, issue 15) where the deviation is
+    # ~1e-7 m, far below the review's colour steps (its limits are ~1e-4 m)
+    for name, tol in (("trailing_edge", 1e-9), ("leading_edge", 1e-9), ("tip", 6e-8)):
         grid = smoothed.named_surfaces[name].evaluate_grid(np.linspace(0.0, 1.0, 25), np.linspace(0.05, 0.95, 9))
         pts = grid.reshape(-1, 3)
         general = sc.signed_deviation(pts, ref, candidates=8)
