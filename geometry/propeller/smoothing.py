@@ -54,6 +54,14 @@ DEVIATION_ITERATIONS = 25
 DEVIATION_WORST = 6
 #: Samples of the tip surface per interval between its cuts, across them.
 DEVIATION_TIP_PER_CUT = 4
+#: Extra samples along the cuts across the blade's edge (t = 1/2 of every cut round the
+#: LE, TE and tip, Hally Eqs. 38-40): DEVIATION_EDGE_SAMPLES over ±DEVIATION_EDGE_CELLS
+#: cells of the coarse grid. The edge radius near the tip is 1e-5..1e-4 D, so the
+#: deviation peaks in a band narrower than one coarse cell; the coarse grid and the
+#: refinement round its worst samples missed it (issue 15: raked demo 1.89e-5 D reported
+#: against 2.97e-5 D by an independent 161² projection, at t = 0.51).
+DEVIATION_EDGE_SAMPLES = 41
+DEVIATION_EDGE_CELLS = 2
 DEVIATION_REFINE = 9
 #: The deviation report also starts from the other face (ξ -> 1 - ξ) where that face's
 #: point lies within this many times the distance found (a thin tip).
@@ -366,11 +374,21 @@ def deviation_report(blade, smoothed_surfaces: dict, param_surfaces: dict, curve
         # the tip surface across its cuts: DEVIATION_TIP_PER_CUT samples per interval (the
         # surface is exact on the cuts; it departs from b between them)
         tu = np.linspace(0.0, 1.0, DEVIATION_TIP_PER_CUT * (len(curves.tip) - 1) + 1) if name == "tip" else t
-        U, V = np.meshgrid(tu, t, indexing="ij")
+        tv = t
+        # a fine band across the blade's edge, along the cuts (u on the LE and TE surfaces,
+        # v on the tip)
+        half = DEVIATION_EDGE_CELLS / (samples - 1)
+        band = np.linspace(0.5 - half, 0.5 + half, DEVIATION_EDGE_SAMPLES)
+        if name == "tip":
+            tv = np.union1d(t, band)
+        elif name in ("leading_edge", "trailing_edge"):
+            tu = np.union1d(t, band)
+        U, V = np.meshgrid(tu, tv, indexing="ij")
         u, v = U.ravel(), V.ravel()
         zone_coord = {"leading_edge": (curves.smoothed_leading, v), "trailing_edge": (curves.smoothed_trailing, v),
                       "tip": (curves.smoothed_tip, u)}
-        local = np.stack(np.meshgrid(np.linspace(-1, 1, DEVIATION_REFINE) / (tu.size - 1),
+        coarse_u = DEVIATION_TIP_PER_CUT * (len(curves.tip) - 1) + 1 if name == "tip" else samples
+        local = np.stack(np.meshgrid(np.linspace(-1, 1, DEVIATION_REFINE) / (coarse_u - 1),
                                      np.linspace(-1, 1, DEVIATION_REFINE) / (samples - 1), indexing="ij"))
         X = S.evaluate(u, v)
         if name == "tip":
