@@ -20,7 +20,7 @@ from bladesmith.geometry.mold.blade import build_blade  # noqa: E402
 from bladesmith.geometry.mold.caps import blade_caps  # noqa: E402
 from bladesmith.geometry.mold.definition import load_blade  # noqa: E402
 from bladesmith.iges.mold import write_closed_blade  # noqa: E402
-from occ_support import read_with_occ  # noqa: E402
+from occ_support import fluid_volume_mesh, read_with_occ  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SEWING_TOL_FRACTION = 1e-7
@@ -150,58 +150,22 @@ MESH_CASES = [
 
 
 def _fluid_mesh(solid, size_mm: float):
-    """Cut ``solid`` from a box around it in OCC, write the fluid as BREP, and mesh it in
-    3-D with gmsh at the coarse curvature-adapted size (no repair, no healing): (OCC
+    """Cut ``solid`` from a box around it in OCC and mesh the fluid in 3-D with gmsh at the
+    coarse curvature-adapted size, no repair (:func:`occ_support.fluid_volume_mesh`): (OCC
     validity of the fluid, number of tetrahedra, min SICN)."""
-    import tempfile
-
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
     from OCP.BRepBndLib import BRepBndLib
     from OCP.Bnd import Bnd_Box
-    from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
-    from OCP.BRepTools import BRepTools
     from OCP.gp import gp_Pnt
 
-    gmsh = pytest.importorskip("gmsh")
+    pytest.importorskip("gmsh")
     box = Bnd_Box()
     BRepBndLib.Add_s(solid, box)
     lo, hi = box.CornerMin(), box.CornerMax()
     m = BOX_MARGIN * size_mm
     domain = BRepPrimAPI_MakeBox(gp_Pnt(lo.X() - m, lo.Y() - m, lo.Z() - m),
                                  gp_Pnt(hi.X() + m, hi.Y() + m, hi.Z() + m)).Shape()
-    cut = BRepAlgoAPI_Cut(domain, solid)
-    cut.Build()
-    assert cut.IsDone()
-    fluid = cut.Shape()
-    valid = BRepCheck_Analyzer(fluid).IsValid()
-    with tempfile.TemporaryDirectory() as tmp:
-        brep = os.path.join(tmp, "fluid.brep")
-        BRepTools.Write_s(fluid, brep)
-        gmsh.initialize()
-        try:
-            gmsh.option.setNumber("General.Terminal", 0)
-            gmsh.option.setNumber("General.NumThreads", 1)
-            gmsh.model.occ.importShapes(brep)
-            gmsh.model.occ.synchronize()
-            assert len(gmsh.model.getEntities(3)) == 1
-            gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", MESH_CURVATURE_POINTS)
-            gmsh.option.setNumber("Mesh.MeshSizeMax", MESH_MAX_SIZE * size_mm)
-            gmsh.option.setNumber("Mesh.MeshSizeMin", MESH_MIN_SIZE * size_mm)
-            gmsh.option.setNumber("Mesh.Algorithm", 5)
-            gmsh.option.setNumber("Mesh.Algorithm3D", 1)
-            gmsh.option.setNumber("Mesh.OptimizeNetgen", 1)
-            gmsh.model.mesh.generate(3)
-            tets = []
-            for _, tag in gmsh.model.getEntities(3):
-                types, tags, _ = gmsh.model.mesh.getElements(3, tag)
-                for t, ids in zip(types, tags):
-                    if t == 4:  # 4-node tetrahedra
-                        tets.extend(ids)
-            quality = gmsh.model.mesh.getElementQualities(tets, "minSICN")
-        finally:
-            gmsh.finalize()
-    return valid, len(tets), float(np.min(quality))
+    return fluid_volume_mesh(domain, solid, MESH_CURVATURE_POINTS, MESH_MIN_SIZE * size_mm, MESH_MAX_SIZE * size_mm)
 
 
 @pytest.mark.parametrize("name, caps", MESH_CASES)

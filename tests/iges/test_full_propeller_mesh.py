@@ -45,7 +45,7 @@ from bladesmith.geometry.propeller.hub_sector import hub_sector, root_footprint_
 from bladesmith.iges.propeller import (WRAPPED_SURFACES, _blade_surfaces, faces_per_blade,  # noqa: E402
                                        full_propeller_iges_entities, split_at_edges, write_full_propeller_iges)
 from bladesmith.iges.records import TrimmedSurface  # noqa: E402
-from occ_support import read_with_occ  # noqa: E402
+from occ_support import fluid_volume_mesh, read_with_occ  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 MM_PER_M = 1000.0
@@ -242,16 +242,12 @@ def test_full_propeller_sews_into_one_valid_solid(case, tmp_path_factory):
 
 
 def _fluid_mesh(solid, D: float):
-    """Cut the solid from a cylinder around it in OCC, write the fluid as BREP, mesh it in
-    3-D with gmsh: (OCC validity of the fluid, number of tetrahedra, min SICN)."""
-    import tempfile
-
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    """Cut the solid from a cylinder around it in OCC and mesh the fluid in 3-D with gmsh
+    (:func:`occ_support.fluid_volume_mesh`): (OCC validity of the fluid, number of
+    tetrahedra, min SICN)."""
     from OCP.BRepBndLib import BRepBndLib
-    from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.Bnd import Bnd_Box
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
-    from OCP.BRepTools import BRepTools
     from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
 
     Dmm = D * MM_PER_M
@@ -260,38 +256,7 @@ def _fluid_mesh(solid, D: float):
     z0, z1 = box.CornerMin().Z() - DOMAIN_MARGIN * Dmm, box.CornerMax().Z() + DOMAIN_MARGIN * Dmm
     cylinder = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, z0), gp_Dir(0, 0, 1)), DOMAIN_RADIUS * 0.5 * Dmm,
                                         z1 - z0).Shape()
-    cut = BRepAlgoAPI_Cut(cylinder, solid)
-    cut.Build()
-    assert cut.IsDone()
-    fluid = cut.Shape()
-    valid = BRepCheck_Analyzer(fluid).IsValid()
-    with tempfile.TemporaryDirectory() as tmp:
-        brep = os.path.join(tmp, "fluid.brep")
-        BRepTools.Write_s(fluid, brep)
-        gmsh.initialize()
-        try:
-            gmsh.option.setNumber("General.Terminal", 0)
-            gmsh.option.setNumber("General.NumThreads", 1)
-            gmsh.model.occ.importShapes(brep)
-            gmsh.model.occ.synchronize()
-            assert len(gmsh.model.getEntities(3)) == 1
-            gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", MESH_CURVATURE_POINTS)
-            gmsh.option.setNumber("Mesh.MeshSizeMax", MESH_MAX_SIZE * Dmm)
-            gmsh.option.setNumber("Mesh.MeshSizeMin", MESH_MIN_SIZE * Dmm)
-            gmsh.option.setNumber("Mesh.Algorithm", 5)
-            gmsh.option.setNumber("Mesh.Algorithm3D", 1)
-            gmsh.option.setNumber("Mesh.OptimizeNetgen", 1)
-            gmsh.model.mesh.generate(3)
-            tets = []
-            for _, tag in gmsh.model.getEntities(3):
-                types, tags, _ = gmsh.model.mesh.getElements(3, tag)
-                for t, ids in zip(types, tags):
-                    if t == 4:  # 4-node tetrahedra
-                        tets.extend(ids)
-            quality = gmsh.model.mesh.getElementQualities(tets, "minSICN")
-        finally:
-            gmsh.finalize()
-    return valid, len(tets), float(np.min(quality))
+    return fluid_volume_mesh(cylinder, solid, MESH_CURVATURE_POINTS, MESH_MIN_SIZE * Dmm, MESH_MAX_SIZE * Dmm)
 
 
 def _mesh_params():
