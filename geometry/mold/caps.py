@@ -212,13 +212,32 @@ def rounded_cap(upper: BSplineSurface, lower: BSplineSurface, inward, bulge: flo
     return cap
 
 
+def closed_surfaces(molds) -> dict:
+    """The faces of the closed blade besides its caps: the mold surfaces
+    (:attr:`~.blade.BladeMolds.surfaces`), with each trailing-edge base that runs the
+    whole span of its zone (root to joint, joint to tip: a trailing edge blunt everywhere,
+    e.g. by ``min_trailing_edge_thickness``) made part of its lower face
+    (:func:`lower_with_base`). A base that ends inside its zone (the trailing edge turns
+    sharp there) stays a face of its own."""
+    out = dict(molds.surfaces)
+    for lower, prefix in (("lower", "trailing_edge"), ("transition_lower", "transition_trailing_edge")):
+        pieces = [k for k in out if k == prefix or k.startswith(prefix + "_")]
+        if lower not in out or len(pieces) != 1:
+            continue
+        base, lo = out[pieces[0]], out[lower]
+        if base.knots_v[0] == lo.knots_v[0] and base.knots_v[-1] == lo.knots_v[-1]:
+            out[lower] = lower_with_base(lo, out.pop(pieces[0]))
+    return out
+
+
 def blade_caps(molds, kind: str = "ruled") -> tuple:
     """(root cap, tip cap) of :class:`~.blade.BladeMolds`: the root over the transitions'
     (or, without them, the halves') v = 0 rows, the tip over the halves' v = 1 rows (with
-    the trailing-edge base's row when the trailing edge is blunt). kind: "ruled"
-    (:func:`ruled_cap`, BSplineSurface, any section) or "planar" (:func:`planar_cap`, a
-    :class:`Cap`, only for planar end sections)."""
-    s = molds.surfaces
+    the trailing-edge base's row when the trailing edge is blunt), of the faces of
+    :func:`closed_surfaces`. kind: "ruled" (:func:`ruled_cap`, BSplineSurface, any
+    section) or "planar" (:func:`planar_cap`, a :class:`Cap`, only for planar end
+    sections)."""
+    s = closed_surfaces(molds)
 
     def end(halves, prefix, v_end):
         """The halves and the trailing-edge bases (``prefix``, ``prefix_2``, ...) that reach
@@ -251,3 +270,80 @@ def blade_caps(molds, kind: str = "ruled") -> tuple:
     if kind != "ruled":
         raise GeometryError(f"unknown cap kind {kind!r}; expected 'ruled', 'planar' or 'rounded'")
     return ruled_cap(root[0], root[1], False, span), ruled_cap(tip[0], tip[1], True, -span)
+
+
+# ---------------------------------------------------------------------------------------
+# the trailing-edge base as part of the lower face (closed blade only; the molds keep it apart)
+# ---------------------------------------------------------------------------------------
+#: The rounded corner where the lower face turns onto the trailing-edge base reaches this
+#: fraction of the base's width along each side of the corner (:func:`lower_with_base`).
+CORNER_BLEND = 0.25
+
+
+def lower_with_base(lower: BSplineSurface, base: BSplineSurface, blend: float = CORNER_BLEND) -> BSplineSurface:
+    """The lower half and a blunt trailing-edge base (ruled, lower(1, v) -> upper(0, v), the
+    same v knots) as one C1 surface: the lower face turns round the trailing-edge corner
+    onto the base and ends on the upper half's trailing edge.
+
+    Why: a base 4-32 mm wide on a 61 m blade is a face a coarse mesher (0.3 m elements)
+    can only fill with needle triangles, whose tetrahedra are slivers (NREL 5-MW, min SICN
+    0.003 along the whole span). As part of the lower face it needs no mesh edge of its own.
+
+    Construction, exact except at the corner (NURBS Book §5.2 knot insertion and §5.4
+    removal): the base is degree-elevated to p in u (control points a + i (b - a) / p) and
+    joined to the lower half at u = s (knot of multiplicity p, C0), s the lower half's share
+    of the mean row length. Knots s - e1 and s + e2 are inserted p times, e2 = ``blend`` ×
+    (1 - s) (a ``blend`` share of the base's width) and e1 so that the lower side of the
+    corner is as long in 3-D (mean over v). The two Bezier pieces that meet at the corner
+    are replaced by one cubic segment on [s - e1, s + e2] whose inner control points
+    continue the neighbouring legs with the derivative of each side (B1 = P_A + (P_A -
+    P_A-) (s + e2 - (s - e1)) / (s - e1 - u_prev), likewise B2), so the curve is C1 there,
+    and one copy of s - e1 and of s + e2 is removed (their control points P_A, P_B lie
+    on those legs: removal is exact). Outside (s - e1, s + e2) the surface is the lower
+    half (u < s - e1) and the base (u > s + e2) unchanged; its u = 1 edge is the upper half's
+    trailing-edge column, copied."""
+    from ..nurbs.operations import refine_knots_surface
+
+    p, q = lower.degree_u, lower.degree_v
+    if base.degree_v != q or not np.array_equal(base.knots_v, lower.knots_v):
+        raise GeometryError("the trailing-edge base and the lower half do not share their span knots")
+    if lower.weights is not None or base.weights is not None:
+        raise GeometryError("the trailing-edge base can join only non-rational mold halves")
+    if p != 3:
+        raise GeometryError(f"the trailing-edge corner blend is cubic; the lower half is of degree {p} across")
+    P = lower.control_points
+    a, b = base.control_points[0], base.control_points[1]
+    if not np.array_equal(a, P[-1]):
+        raise GeometryError("the trailing-edge base does not start on the lower half's trailing edge")
+    width = np.linalg.norm(b - a, axis=1)
+    if width.min() <= 0:
+        raise GeometryError("the trailing-edge base closes to a point; it cannot be part of the lower face")
+    row = np.linalg.norm(np.diff(P, axis=0), axis=2).sum(axis=0)  # control-polygon length per row
+    s = float(row.mean() / (row.mean() + width.mean()))
+    n = P.shape[0]
+    U = np.concatenate([lower.knots_u[:n] * s, [s] * p, [1.0] * (p + 1)])
+    ext = [a + (b - a) * (i / p) for i in range(1, p)] + [np.array(b)]
+    joined = BSplineSurface(p, q, U, lower.knots_v, np.concatenate([P, np.stack(ext)], axis=0))
+    # lower side of the corner as long as the base side: |S_u(1-)| of the lower half is
+    # p |P_n-1 - P_n-2| / (1 - u_last) in its own parameter, / s in the joined one
+    u_last = float(lower.knots_u[n - 1])
+    speed = p * np.linalg.norm(P[-1] - P[-2], axis=1).mean() / ((1.0 - u_last) * s)
+    e2 = blend * (1.0 - s)
+    e1 = min(blend * width.mean() / speed, 0.5 * (s - u_last * s))
+    ua, ub = s - e1, s + e2
+    R = refine_knots_surface(joined, "u", [ua] * p + [ub] * p)
+    K, N = R.knots_u, R.control_points.copy()
+    # the control points at C(ua) and C(ub): a knot run of multiplicity p ending at index k
+    # holds the curve point P_(k - p)
+    ia = int(np.nonzero(np.isclose(K, ua, rtol=0, atol=1e-15))[0][-1]) - p
+    ib = int(np.nonzero(np.isclose(K, ub, rtol=0, atol=1e-15))[0][-1]) - p
+    u_prev = float(K[ia])  # the knot before the ua run
+    u_next = 1.0
+    PA, PB = N[ia], N[ib]
+    B1 = PA + (PA - N[ia - 1]) * (ub - ua) / (ua - u_prev)
+    B2 = PB - (N[ib + 1] - PB) * (ub - ua) / (u_next - ub)
+    net = np.concatenate([N[:ia], B1[None], B2[None], N[ib + 1:]], axis=0)
+    knots = np.concatenate([K[:ia + 1], [ua] * (p - 1), [ub] * (p - 1), K[ib + p + 1:]])
+    net[-1] = b  # the upper half's trailing-edge column, copied
+    net[0] = P[0]  # the leading-edge parting line, copied
+    return BSplineSurface(p, q, knots, lower.knots_v, net)

@@ -12,6 +12,7 @@ Format (every array of ``[stations]`` has one value per station, root to tip)::
     smooth_airfoils = false            # optional; smooth the aerodynamic stations' airfoils first
                                        # (Hvid 1993 smoothfoil, default jobcard)
     smooth_passes = 4                  # optional; passes of its ad hoc curvature smoother (1-50)
+    min_trailing_edge_thickness = 0.004  # optional, m; thinner trailing edges are opened to it
 
     [stations]
     r = [...]           # m, strictly increasing
@@ -81,6 +82,7 @@ STATION_KEYS = REQUIRED + OPTIONAL
 TOP_LEVEL_KEYS = (
     "name", "hub_radius", "mold_direction", "wrap", "first_aerodynamic_station", "control_points", "tolerance",
     "smooth_airfoils", "smooth_passes", "stations",
+    "min_trailing_edge_thickness",  # m: every station's trailing edge at least this thick (issue 16)
     # issue 19: the paper's controls
     "section_degree",     # p of the section curves (Hosseini Eq. 1), 2..5, default 3
     "span_degree",        # q across the sections (Eq. 4), 1..5, default 3
@@ -103,6 +105,10 @@ MAX_TWIST_DEG = 180.0
 #: fit is as large as the tolerance.
 MIN_TOLERANCE = 1e-9
 MAX_TOLERANCE = 0.1
+#: min_trailing_edge_thickness may be at most this fraction of the smallest chord.
+MAX_TE_THICKNESS_CHORDS = 0.05
+#: The trailing edge is opened over this aft fraction of the chord (:func:`opened_trailing_edge`).
+TE_OPENING_BLEND = 0.2
 
 
 def circle_airfoil() -> Airfoil:
@@ -180,6 +186,9 @@ class BladeDefinition:
     tangent_magnitudes: tuple | None = None
     #: Per station: the tolerance (chord fraction), or None for ``tolerance`` everywhere.
     station_tolerances: tuple | None = None
+    #: m: stations with a thinner trailing edge (sharp ones among them) were opened to it
+    #: (:func:`opened_trailing_edge`); 0 keeps every airfoil as read.
+    min_trailing_edge_thickness: float = 0.0
 
     def to_dict(self) -> dict:
         """The definition as TOML-ready values (airfoils by name or path)."""
@@ -191,6 +200,7 @@ class BladeDefinition:
             "smooth_airfoils": self.smooth_airfoils, "smooth_passes": self.smooth_passes,
             "section_degree": self.section_degree, "span_degree": self.span_degree,
             "tangent_magnitude": "sqp" if self.tangent_magnitudes is None else list(self.tangent_magnitudes),
+            "min_trailing_edge_thickness": self.min_trailing_edge_thickness,
             "stations": {
                 "r": [s.r for s in st], "chord": [s.chord for s in st], "twist_deg": [s.twist_deg for s in st],
                 "pitch_axis": [s.pitch_axis for s in st], "prebend": [s.prebend for s in st],
@@ -322,8 +332,42 @@ def blade_from_dict(data: dict, path: str = "", base: pathlib.Path | None = None
                                       field=f"stations.tolerance[{k}]")
     if smooth:
         stations = _smoothed_stations(stations, first, path, passes)
+    te_min = _number(data.get("min_trailing_edge_thickness", 0.0), path, "min_trailing_edge_thickness")
+    smallest = min(s.chord for s in stations)
+    if not 0.0 <= te_min <= MAX_TE_THICKNESS_CHORDS * smallest:
+        raise DefinitionError(f"expected a thickness in [0, MAX_TE_THICKNESS_CHORDS = {MAX_TE_THICKNESS_CHORDS:g} x "
+                              f"the smallest chord = {MAX_TE_THICKNESS_CHORDS * smallest:g}] m, got {te_min!r}",
+                              path=path, field="min_trailing_edge_thickness")
+    if te_min > 0:
+        stations = [replace(s, airfoil=opened_trailing_edge(s.airfoil, te_min / s.chord)) for s in stations]
     return BladeDefinition(name, hub, tuple(stations), d / np.linalg.norm(d), wrap, first, n, tol, path, smooth,
-                           passes, p, q, magnitudes, station_tols)
+                           passes, p, q, magnitudes, station_tols, te_min)
+
+
+def opened_trailing_edge(foil: Airfoil, thickness: float, blend: float = TE_OPENING_BLEND) -> Airfoil:
+    """``foil`` with its trailing edge at least ``thickness`` (chord fraction) thick.
+
+    Why (issue 16): a blunt trailing edge that turns sharp between two stations (NREL
+    5-MW: 12.6 mm at r = 40.45 m, sharp NACA 64-618 from 44.55 m; the sharp root circle
+    before the 8.3-11.75 m DU 40) ends its base in a zero-angle cusp, which no mesher
+    fills with well-shaped elements; and a laminated blade is never sharp: its trailing
+    edge is at least the bond line thick. The missing thickness g = thickness - (the
+    airfoil's) is added half to each side, y_upper += g/2 b(x), y_lower -= g/2 b(x), with
+    b the C1 smoothstep 3t² - 2t³ of t = (x - (1 - blend)) / blend on the aft ``blend`` of
+    the chord (0 ahead of it): the camber line stays, the outline moves at most g/2 (at
+    the trailing edge) and keeps its slope at x = 1 - blend. A trailing edge already as
+    thick is returned unchanged."""
+    g = thickness - foil.trailing_edge_thickness
+    if g <= 0:
+        return foil
+
+    def lift(xy, sign):
+        t = np.clip((xy[:, 0] - (1.0 - blend)) / blend, 0.0, 1.0)
+        out = np.array(xy, dtype=np.float64)
+        out[:, 1] += sign * 0.5 * g * t * t * (3.0 - 2.0 * t)
+        return out
+
+    return replace(foil, upper=lift(foil.upper, 1.0), lower=lift(foil.lower, -1.0))
 
 
 def _degree(value, bounds, path, fld) -> int:
