@@ -156,6 +156,7 @@ def settings_to_dict(settings) -> dict:
         "tolerance": typed(settings.tolerance),
         "smooth_airfoils": bool(settings.smooth_airfoils),
         "smooth_passes": int(settings.smooth_passes),
+        "min_trailing_edge_thickness": typed(settings.min_trailing_edge_thickness),
         "section_degree": int(settings.section_degree),
         "span_degree": int(settings.span_degree),
         "tangent_magnitude": ("sqp" if settings.tangent_mode == "SQP"
@@ -189,6 +190,7 @@ def definition_to_settings(settings, defn: BladeDefinition, base_dir: str = "") 
         settings.tolerance = defn.tolerance
         settings.smooth_airfoils = defn.smooth_airfoils
         settings.smooth_passes = defn.smooth_passes
+        settings.min_trailing_edge_thickness = defn.min_trailing_edge_thickness
         settings.section_degree = defn.section_degree
         settings.span_degree = defn.span_degree
         settings.tangent_mode = "SQP" if defn.tangent_magnitudes is None else "HAND"

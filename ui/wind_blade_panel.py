@@ -91,6 +91,10 @@ def _annotations() -> dict:
             "fewer keep the sections closer to the files, the status line gives the deviation",
             default=4, min=1, max=50, update=_edited,
         ),
+        "min_trailing_edge_thickness": _float(
+            "Min TE Thickness", "Every station's trailing edge at least this thick (sharp ones are opened over "
+            "the aft 20 % of the chord); 0 keeps the airfoils as read", 0.0, unit="LENGTH", soft_min=0.0,
+            precision=4, step=0.01),
         "first_aerodynamic_station": IntProperty(
             name="First Airfoil Station", description="Index of the first aerodynamic station; the stations "
             "before it form the root transition (Hosseini §5.1)", default=0, soft_min=0, update=_edited,
@@ -222,7 +226,7 @@ class BLADESMITH_PT_wind_blade(_WindBladePanel, bpy.types.Panel):
         col = layout.column()
         col.use_property_split = True
         for name in ("definition_name", "hub_radius", "mold_direction", "wrap", "smooth_airfoils", "smooth_passes",
-                     "first_aerodynamic_station", "control_points", "tolerance", "section_degree", "span_degree",
+                     "min_trailing_edge_thickness", "first_aerodynamic_station", "control_points", "tolerance", "section_degree", "span_degree",
                      "tangent_mode", "tangent_upper", "tangent_lower", "mold_halves", "base_dir"):
             row = col.row()
             row.enabled = ((name != "smooth_passes" or s.smooth_airfoils)

@@ -189,3 +189,46 @@ def test_fluid_around_the_closed_blade_volume_meshes(name, caps, tmp_path):
         assert min_sicn <= MIN_SICN, f"{name} now meshes (min SICN {min_sicn:.4g}): drop it from KNOWN_SLIVERS"
         pytest.xfail(f"min SICN {min_sicn:.4g}: {KNOWN_SLIVERS[name, caps]}")
     assert min_sicn > MIN_SICN, f"min SICN {min_sicn:.4g}"
+
+
+# ---------------------------------------------------------------------------------------
+# the trailing-edge base as part of the lower face (issue 16: NREL 5-MW's closed blade)
+# ---------------------------------------------------------------------------------------
+def test_lower_face_with_the_trailing_edge_base_is_the_halves_and_the_base():
+    """NREL 5-MW's closed blade: its trailing-edge bases (blunt over the whole span since
+    the preset opens its sharp stations to 4 mm) are part of the lower faces. The merged
+    face is C1 (OCC reads it without a C0 warning), equals the lower half and the base
+    outside the corner blend, ends exactly on the upper half's TE column and the LE
+    parting line, and rounds the corner by a fraction of the base's width."""
+    from bladesmith.geometry.mold.caps import CORNER_BLEND
+
+    molds = molds_of("nrel5mw")
+    faces = closed_surfaces(molds)
+    assert "trailing_edge" not in faces and "transition_trailing_edge" not in faces
+    assert not any(k.startswith("trailing_edge") for k in faces)
+    for lower, base, upper in ((molds.lower, molds.surfaces["trailing_edge"], molds.upper),
+                               (molds.transition_lower, molds.surfaces["transition_trailing_edge"],
+                                molds.transition_upper)):
+        name = "lower" if lower is molds.lower else "transition_lower"
+        m = faces[name]
+        p = m.degree_u
+        K = m.knots_u
+        inner, counts = np.unique(K[p + 1:-p - 1], return_counts=True)
+        assert counts.max() <= p - 1, "the merged face must be C1 (no C0 knot)"
+        assert np.array_equal(m.control_points[-1], upper.control_points[0])  # shared TE edge, copied
+        assert np.array_equal(m.control_points[0], lower.control_points[0])  # LE parting line, copied
+        ua, ub = inner[counts == p - 1][-2:]
+        s = K[p + 1] / lower.knots_u[p + 1]
+        size = lower.size()
+        v = np.linspace(0.0, 1.0, 41)
+        for u in np.linspace(0.0, ua, 9):
+            assert np.abs(m.evaluate(u, v) - lower.evaluate(u / s, v)).max() <= 1e-12 * size
+        for u in np.linspace(ub, 1.0, 5):
+            assert np.abs(m.evaluate(u, v) - base.evaluate((u - s) / (1.0 - s), v)).max() <= 1e-12 * size
+        # the corner: the blend cuts it by less than the blend's share of the base's width
+        corner = lower.evaluate(1.0, v)
+        width = np.linalg.norm(upper.evaluate(0.0, v) - corner, axis=1)
+        cut = np.linalg.norm(m.evaluate(s, v) - corner, axis=1)
+        print(f"\n{name}: TE corner rounded by {1e3 * cut.max():.2f} mm at most "
+              f"(base {1e3 * width.min():.1f}-{1e3 * width.max():.1f} mm wide)")
+        assert np.all(cut < CORNER_BLEND * width)
