@@ -277,7 +277,7 @@ def blade_caps(molds, kind: str = "ruled") -> tuple:
 # ---------------------------------------------------------------------------------------
 #: The rounded corner where the lower face turns onto the trailing-edge base reaches this
 #: fraction of the base's width along each side of the corner (:func:`lower_with_base`).
-CORNER_BLEND = 0.25
+CORNER_BLEND = 0.1
 
 
 def lower_with_base(lower: BSplineSurface, base: BSplineSurface, blend: float = CORNER_BLEND) -> BSplineSurface:

@@ -132,13 +132,20 @@ MESH_MIN_SIZE = 0.005
 #: conditioning; the propeller mesh test (test_full_propeller_mesh.py) uses the same bar.
 MIN_SICN = 0.05
 
-#: Blades whose closed solid is valid but whose coarse mesh is known to miss MIN_SICN, with
+#: (Blade, caps) whose closed solid is valid but whose coarse mesh is known to miss MIN_SICN, with
 #: the cause measured; everything else is still asserted, and the test fails if they pass.
-KNOWN_SLIVERS: dict = {}
+KNOWN_SLIVERS = {
+    ("nrel5mw", "ruled"): "the flat ruled tip cap (1.42 m chord, 0.26 m thick) meets the upper half's tip row, "
+                          "which gmsh splits into 0.9 m segments (the row's own curvature is low); the cap's "
+                          "triangle on such a segment is a needle, 11 mm high, and its tetrahedron a sliver "
+                          "(measured min SICN 0.033, one tetrahedron). The rounded tip's curvature refines that "
+                          "row (min SICN 0.19)",
+}
 
 MESH_CASES = [
     pytest.param("s823_small", "ruled", id="s823_small-ruled"),
     pytest.param("s823_small", "rounded", id="s823_small-rounded"),
+    pytest.param("nrel5mw", "ruled", id="nrel5mw-ruled"),
     pytest.param("nrel5mw", "rounded", id="nrel5mw-rounded"),
 ]
 
