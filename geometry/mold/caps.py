@@ -217,16 +217,35 @@ def closed_surfaces(molds) -> dict:
     (:attr:`~.blade.BladeMolds.surfaces`), with each trailing-edge base that runs the
     whole span of its zone (root to joint, joint to tip: a trailing edge blunt everywhere,
     e.g. by ``min_trailing_edge_thickness``) made part of its lower face
-    (:func:`lower_with_base`). A base that ends inside its zone (the trailing edge turns
-    sharp there) stays a face of its own."""
+    (:func:`lower_with_base`, one corner blend for both zones, so the root joint row is
+    the same and is copied). When a base ends inside its zone (the trailing edge turns
+    sharp there: IEA 15 MW's root circle) every base stays a face of its own: a merged
+    face's rounded corner would not meet the neighbouring zone's sharp one."""
     out = dict(molds.surfaces)
+    pairs = []
     for lower, prefix in (("lower", "trailing_edge"), ("transition_lower", "transition_trailing_edge")):
         pieces = [k for k in out if k == prefix or k.startswith(prefix + "_")]
-        if lower not in out or len(pieces) != 1:
+        if lower not in out or not pieces:
             continue
         base, lo = out[pieces[0]], out[lower]
-        if base.knots_v[0] == lo.knots_v[0] and base.knots_v[-1] == lo.knots_v[-1]:
-            out[lower] = lower_with_base(lo, out.pop(pieces[0]))
+        if len(pieces) != 1 or base.knots_v[0] != lo.knots_v[0] or base.knots_v[-1] != lo.knots_v[-1]:
+            return out  # a base ends inside its zone: every base stays a face (the joint row must match)
+        pairs.append((lower, pieces[0]))
+    if not pairs:
+        return out
+    # one corner for both zones: the joint row (the transition's w = 1, the aero half's v = 0)
+    # is then made by the same arithmetic from the same rows, and is copied besides
+    corner = corner_parameters(out[pairs[0][0]], out[pairs[0][1]])
+    for lower, prefix in pairs:
+        out[lower] = lower_with_base(out[lower], out.pop(prefix), corner=corner)
+    if len(pairs) == 2:
+        aero, root = out["lower"], out["transition_lower"]
+        net = root.control_points.copy()
+        size = max(aero.size(), root.size())
+        if np.abs(net[:, -1] - aero.control_points[:, 0]).max() > 1e-12 * size:
+            raise GeometryError("the merged lower faces do not meet on the root joint")
+        net[:, -1] = aero.control_points[:, 0]
+        out["transition_lower"] = BSplineSurface(root.degree_u, root.degree_v, root.knots_u, root.knots_v, net)
     return out
 
 
@@ -280,7 +299,23 @@ def blade_caps(molds, kind: str = "ruled") -> tuple:
 CORNER_BLEND = 0.1
 
 
-def lower_with_base(lower: BSplineSurface, base: BSplineSurface, blend: float = CORNER_BLEND) -> BSplineSurface:
+def corner_parameters(lower: BSplineSurface, base: BSplineSurface, blend: float = CORNER_BLEND) -> tuple:
+    """(s, e1, e2) of :func:`lower_with_base`: s the lower half's share of the mean row
+    length (control polygon), e2 = ``blend`` (1 - s), e1 such that the lower side of the
+    corner blend is as long in 3-D as the base side (mean over the rows; |S_u(1-)| of the
+    lower half is p |P_n-1 - P_n-2| / (1 - u_last), NURBS Book Eq. 3.7, / s after the
+    join), at most half the lower half's last knot span."""
+    p, P = lower.degree_u, lower.control_points
+    width = np.linalg.norm(base.control_points[1] - base.control_points[0], axis=1)
+    row = np.linalg.norm(np.diff(P, axis=0), axis=2).sum(axis=0)
+    s = float(row.mean() / (row.mean() + width.mean()))
+    u_last = float(lower.knots_u[P.shape[0] - 1])
+    speed = p * np.linalg.norm(P[-1] - P[-2], axis=1).mean() / ((1.0 - u_last) * s)
+    return s, float(min(blend * width.mean() / speed, 0.5 * (s - u_last * s))), blend * (1.0 - s)
+
+
+def lower_with_base(lower: BSplineSurface, base: BSplineSurface, blend: float = CORNER_BLEND,
+                    corner: tuple | None = None) -> BSplineSurface:
     """The lower half and a blunt trailing-edge base (ruled, lower(1, v) -> upper(0, v), the
     same v knots) as one C1 surface: the lower face turns round the trailing-edge corner
     onto the base and ends on the upper half's trailing edge.
@@ -291,17 +326,17 @@ def lower_with_base(lower: BSplineSurface, base: BSplineSurface, blend: float = 
 
     Construction, exact except at the corner (NURBS Book §5.2 knot insertion and §5.4
     removal): the base is degree-elevated to p in u (control points a + i (b - a) / p) and
-    joined to the lower half at u = s (knot of multiplicity p, C0), s the lower half's share
-    of the mean row length. Knots s - e1 and s + e2 are inserted p times, e2 = ``blend`` ×
-    (1 - s) (a ``blend`` share of the base's width) and e1 so that the lower side of the
-    corner is as long in 3-D (mean over v). The two Bezier pieces that meet at the corner
-    are replaced by one cubic segment on [s - e1, s + e2] whose inner control points
-    continue the neighbouring legs with the derivative of each side (B1 = P_A + (P_A -
-    P_A-) (s + e2 - (s - e1)) / (s - e1 - u_prev), likewise B2), so the curve is C1 there,
-    and one copy of s - e1 and of s + e2 is removed (their control points P_A, P_B lie
-    on those legs: removal is exact). Outside (s - e1, s + e2) the surface is the lower
-    half (u < s - e1) and the base (u > s + e2) unchanged; its u = 1 edge is the upper half's
-    trailing-edge column, copied."""
+    joined to the lower half at u = s (knot of multiplicity p, C0). Knots s - e1 and
+    s + e2 are inserted p times ((s, e1, e2) of :func:`corner_parameters`, or ``corner``:
+    faces that share a row use the same, so the row comes out the same). The two Bezier
+    pieces that meet at the corner are replaced by one cubic segment on [s - e1, s + e2]
+    whose inner control points continue the neighbouring legs with the derivative of each
+    side (B1 = P_A + (P_A - P_A-) (e1 + e2) / (s - e1 - u_prev), likewise B2), so the
+    curve is C1 there, and one copy of s - e1 and of s + e2 is removed (their control
+    points P_A, P_B lie on those legs: removal is exact). Outside (s - e1, s + e2) the
+    surface is the lower half (u < s - e1) and the base (u > s + e2) unchanged; its u = 1
+    edge is the upper half's trailing-edge column and its u = 0 edge the LE parting line,
+    copied."""
     from ..nurbs.operations import refine_knots_surface
 
     p, q = lower.degree_u, lower.degree_v
@@ -315,21 +350,13 @@ def lower_with_base(lower: BSplineSurface, base: BSplineSurface, blend: float = 
     a, b = base.control_points[0], base.control_points[1]
     if not np.array_equal(a, P[-1]):
         raise GeometryError("the trailing-edge base does not start on the lower half's trailing edge")
-    width = np.linalg.norm(b - a, axis=1)
-    if width.min() <= 0:
+    if np.linalg.norm(b - a, axis=1).min() <= 0:
         raise GeometryError("the trailing-edge base closes to a point; it cannot be part of the lower face")
-    row = np.linalg.norm(np.diff(P, axis=0), axis=2).sum(axis=0)  # control-polygon length per row
-    s = float(row.mean() / (row.mean() + width.mean()))
+    s, e1, e2 = corner_parameters(lower, base, blend) if corner is None else corner
     n = P.shape[0]
     U = np.concatenate([lower.knots_u[:n] * s, [s] * p, [1.0] * (p + 1)])
     ext = [a + (b - a) * (i / p) for i in range(1, p)] + [np.array(b)]
     joined = BSplineSurface(p, q, U, lower.knots_v, np.concatenate([P, np.stack(ext)], axis=0))
-    # lower side of the corner as long as the base side: |S_u(1-)| of the lower half is
-    # p |P_n-1 - P_n-2| / (1 - u_last) in its own parameter, / s in the joined one
-    u_last = float(lower.knots_u[n - 1])
-    speed = p * np.linalg.norm(P[-1] - P[-2], axis=1).mean() / ((1.0 - u_last) * s)
-    e2 = blend * (1.0 - s)
-    e1 = min(blend * width.mean() / speed, 0.5 * (s - u_last * s))
     ua, ub = s - e1, s + e2
     R = refine_knots_surface(joined, "u", [ua] * p + [ub] * p)
     K, N = R.knots_u, R.control_points.copy()

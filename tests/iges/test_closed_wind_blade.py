@@ -212,6 +212,8 @@ def test_lower_face_with_the_trailing_edge_base_is_the_halves_and_the_base():
     molds = molds_of("nrel5mw")
     faces = closed_surfaces(molds)
     assert "trailing_edge" not in faces and "transition_trailing_edge" not in faces
+    # the root joint: one row for both merged faces, copied
+    assert np.array_equal(faces["transition_lower"].control_points[:, -1], faces["lower"].control_points[:, 0])
     assert not any(k.startswith("trailing_edge") for k in faces)
     for lower, base, upper in ((molds.lower, molds.surfaces["trailing_edge"], molds.upper),
                                (molds.transition_lower, molds.surfaces["transition_trailing_edge"],
@@ -232,10 +234,11 @@ def test_lower_face_with_the_trailing_edge_base_is_the_halves_and_the_base():
             assert np.abs(m.evaluate(u, v) - lower.evaluate(u / s, v)).max() <= 1e-12 * size
         for u in np.linspace(ub, 1.0, 5):
             assert np.abs(m.evaluate(u, v) - base.evaluate((u - s) / (1.0 - s), v)).max() <= 1e-12 * size
-        # the corner: the blend cuts it by less than the blend's share of the base's width
+        # the corner: the blend cuts it by less than its legs (the blend's share of the widest base;
+        # the lower-side leg is set from the mean width, so it is not shorter where the base is thin)
         corner = lower.evaluate(1.0, v)
         width = np.linalg.norm(upper.evaluate(0.0, v) - corner, axis=1)
         cut = np.linalg.norm(m.evaluate(s, v) - corner, axis=1)
         print(f"\n{name}: TE corner rounded by {1e3 * cut.max():.2f} mm at most "
               f"(base {1e3 * width.min():.1f}-{1e3 * width.max():.1f} mm wide)")
-        assert np.all(cut < CORNER_BLEND * width)
+        assert np.all(cut < CORNER_BLEND * width.max()) and cut.max() < 1.5e-3

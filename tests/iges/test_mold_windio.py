@@ -71,3 +71,29 @@ def test_iea15mw_reads_and_sews_open_only_at_root_and_tip(iea):
         assert at_root or at_tip, f"free edge {i} at z = {z}"
         ends.append("root" if at_root else "tip")
     assert sorted(set(ends)) == ["root", "tip"] and sewing.NbMultipleEdges() == 0
+
+
+def test_iea15mw_closed_blade_is_one_valid_solid(iea, tmp_path):
+    """Issue 16: the closed IEA 15 MW (rounded caps). Its root circle is sharp, so the root
+    transition's trailing-edge base ends inside its zone and every base stays a face of
+    its own (:func:`~bladesmith.geometry.mold.caps.closed_surfaces`: a merged lower face's
+    rounded corner would not meet the transition's sharp one): 8 faces, 0 free edges."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.TopoDS import TopoDS
+
+    from bladesmith.geometry.mold.caps import closed_surfaces
+    from bladesmith.iges.mold import write_closed_blade
+
+    molds, _ = iea
+    assert set(closed_surfaces(molds)) == set(molds.surfaces)
+    occ = read_with_occ(write_closed_blade(tmp_path / "iea15_closed.igs", molds, caps="rounded"))
+    assert occ.load_messages == [] and occ.transfer_messages == []
+    assert len(occ.faces) == len(molds.surfaces) + 2 == 8
+    size = max(s.size() for s in molds.surfaces.values())
+    sewing = BRepBuilderAPI_Sewing(1e-7 * size * MM_PER_M)
+    for face in occ.faces:
+        sewing.Add(face)
+    sewing.Perform()
+    assert sewing.NbFreeEdges() == 0
+    assert BRepCheck_Analyzer(BRepBuilderAPI_MakeSolid(TopoDS.Shell(sewing.SewedShape())).Solid()).IsValid()
