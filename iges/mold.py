@@ -50,11 +50,12 @@ def cap_record(cap, scale: float, label: str):
 
 def closed_blade_records(molds: BladeMolds, units: str = "m", caps: str = "ruled") -> list:
     """The mold surfaces (:func:`~bladesmith.geometry.mold.caps.closed_surfaces`: a
-    trailing-edge base that runs the whole span is part of the lower face) plus root and tip caps (:func:`~bladesmith.geometry.mold.caps.blade_caps`):
-    faces that sew into one closed shell. caps: "ruled" (a 128 between the halves' end
-    rows, any section), "planar" (a trimmed plane whose loop is the end rows themselves;
-    only where the end section is planar) or "rounded" (a planar root, a rounded tip
-    tangent to the mold halves)."""
+    trailing-edge base that runs the whole span is part of the lower face) plus root and
+    tip caps (:func:`~bladesmith.geometry.mold.caps.blade_caps`): faces that sew into one
+    closed shell. caps: "ruled" (a 128 between the halves' end rows, any section),
+    "planar" (a trimmed plane whose loop is the end rows themselves; only where the end
+    section is planar) or "rounded" (a planar root, a rounded tip tangent to the mold
+    halves)."""
     from ..geometry.mold.caps import blade_caps, closed_surfaces
 
     scale = 1.0 / METRES_PER_UNIT[units.lower()]

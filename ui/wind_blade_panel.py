@@ -226,8 +226,9 @@ class BLADESMITH_PT_wind_blade(_WindBladePanel, bpy.types.Panel):
         col = layout.column()
         col.use_property_split = True
         for name in ("definition_name", "hub_radius", "mold_direction", "wrap", "smooth_airfoils", "smooth_passes",
-                     "min_trailing_edge_thickness", "first_aerodynamic_station", "control_points", "tolerance", "section_degree", "span_degree",
-                     "tangent_mode", "tangent_upper", "tangent_lower", "mold_halves", "base_dir"):
+                     "min_trailing_edge_thickness", "first_aerodynamic_station", "control_points", "tolerance",
+                     "section_degree", "span_degree", "tangent_mode", "tangent_upper", "tangent_lower", "mold_halves",
+                     "base_dir"):
             row = col.row()
             row.enabled = ((name != "smooth_passes" or s.smooth_airfoils)
                            and (name not in ("tangent_upper", "tangent_lower") or s.tangent_mode == "HAND"))

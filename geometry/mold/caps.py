@@ -25,6 +25,11 @@ root flange (bolted to the pitch bearing), the root circle lies in that plane (t
 structural-zone stations are not wrapped, :func:`~.blade.blade_sections`), and a dome
 there would lie inside the hub. A root that is not planar (a blade without a root
 transition, whose first section is wrapped on its cylinder) gets the ruled cap.
+
+The faces the caps close are :func:`closed_surfaces`: the mold surfaces, with a blunt
+trailing-edge base that runs the whole span made part of the lower face
+(:func:`lower_with_base`, a C1 face with the corner rounded), so that a coarse mesher
+need not fill a 4-32 mm strip with needle triangles (issue 16, NREL 5-MW).
 """
 from __future__ import annotations
 

@@ -121,6 +121,9 @@ def test_nrel5mw_preset_with_blunt_trailing_edge(scene):
     assert np.abs(upper.evaluate(1.0, v) - lower.evaluate(0.0, v)).max() < 1e-10
     s = root.bladesmith_wind_blade
     assert len(s.stations) == 19 and s.le_angle_deg < 0.01 and s.fairness_valid
+    # the preset's 4 mm trailing edge (issue 16) is in the panel and in what a panel edit rebuilds
+    assert s.min_trailing_edge_thickness == pytest.approx(0.004, rel=1e-6)
+    assert ops.settings_to_definition(s).min_trailing_edge_thickness == 0.004
     print(f"\nNREL 5-MW add_wind_blade: {seconds:.2f} s ({s.fitted_control_points} control points per half)")
 
 
