@@ -300,7 +300,8 @@ def blade_caps(molds, kind: str = "ruled") -> tuple:
 # the trailing-edge base as part of the lower face (closed blade only; the molds keep it apart)
 # ---------------------------------------------------------------------------------------
 #: The rounded corner where the lower face turns onto the trailing-edge base reaches this
-#: fraction of the base's width along each side of the corner (:func:`lower_with_base`).
+#: fraction of the base's width along the base, and as far (from the mean width) along the
+#: lower half (:func:`lower_with_base`; NREL 5-MW: the corner moves at most 1.03 mm).
 CORNER_BLEND = 0.1
 
 
