@@ -244,3 +244,31 @@ def test_lower_face_with_the_trailing_edge_base_is_the_halves_and_the_base():
         print(f"\n{name}: TE corner rounded by {1e3 * cut.max():.2f} mm at most "
               f"(base {1e3 * width.min():.1f}-{1e3 * width.max():.1f} mm wide)")
         assert np.all(cut < CORNER_BLEND * width.max()) and cut.max() < 1.5e-3
+
+
+@pytest.mark.parametrize("caps", ["ruled", "rounded"])
+def test_gmsh_reads_the_closed_nrel5mw_without_complaints(caps, tmp_path):
+    """The closed NREL 5-MW file itself (its merged, C1 lower faces among them) imported by
+    gmsh and meshed in 2-D: every face gets inner nodes, gmsh's log has no warning or error."""
+    gmsh = pytest.importorskip("gmsh")
+    molds = molds_of("nrel5mw")
+    path = write_closed_blade(tmp_path / f"nrel5mw_{caps}.igs", molds, caps=caps)
+    gmsh.initialize(readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.logger.start()
+        gmsh.model.occ.importShapes(str(path))
+        gmsh.model.occ.synchronize()
+        faces = gmsh.model.getEntities(2)
+        assert len(faces) == len(closed_surfaces(molds)) + 2
+        lo, hi = np.array(gmsh.model.getBoundingBox(-1, -1)).reshape(2, 3)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.002 * float(np.max(hi - lo)))  # 0.13 m: inner nodes on the caps
+        gmsh.model.mesh.generate(2)
+        for dim, tag in faces:
+            assert len(gmsh.model.mesh.getNodes(dim, tag, includeBoundary=False)[0]) > 0, f"face {tag}"
+        complaints = [line for line in gmsh.logger.get() if line.startswith(("Error", "Warning"))]
+        gmsh.logger.stop()
+    finally:
+        gmsh.finalize()
+    assert complaints == [], complaints
