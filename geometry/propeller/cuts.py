@@ -67,6 +67,8 @@ MARCH_MAX_TURN = 0.12
 #: Cells of the cached surrogate of b used for marching (ξ and w = sqrt(1 - η)).
 CACHE_XI_CELLS = 256
 CACHE_W_CELLS = 48
+#: Extra cell rows built beyond the farthest one reached (:class:`BladeCache`).
+CACHE_ROW_MARGIN = 2
 #: The ξ-search of Eq. 21 must stay this close (in ξ) to the predictor.
 XI_SEARCH_MAX_SHIFT = 0.25
 #: A half-cut that reaches the edge line ξ = ξ_1 farther than this fraction of its
@@ -170,11 +172,24 @@ class BladeCache:
         self.w_max = float(np.sqrt(1.0 - blade.eta_min))
         self.hx = 1.0 / n_xi
         self.hw = self.w_max / n_w
-        xg = np.arange(n_xi + 1) * self.hx
+        self._xg = np.arange(n_xi + 1) * self.hx
         wg = np.arange(n_w + 1) * self.hw
-        wg_eval = np.maximum(wg, np.sqrt(ETA_TIP_GUARD))
-        eta = np.clip(1.0 - wg_eval**2, blade.eta_min, 1.0 - ETA_TIP_GUARD)
-        D = blade.mixed_derivatives(xg[:-1, None], eta[None, :])  # (n_xi, n_w+1, 3, 3, 3)
+        self._wg_eval = np.maximum(wg, np.sqrt(ETA_TIP_GUARD))
+        self._eta = np.clip(1.0 - self._wg_eval**2, blade.eta_min, 1.0 - ETA_TIP_GUARD)
+        self.coef = np.empty((n_xi, n_w, 4, 4, 3))
+        #: cell rows (in w, from the tip) whose coefficients are filled: the cuts near the
+        #: tip visit about half of them, so rows are built when first reached
+        self.rows = 0
+
+    def _build_rows(self, rows: int) -> None:
+        """Fill the coefficients of the cell rows self.rows .. rows - 1 (each cell from
+        the exact b and its derivatives at its corners, as if the whole grid were built)."""
+        rows = min(int(rows), self.n_w)
+        a = self.rows
+        if rows <= a:
+            return
+        xg, wg_eval, eta = self._xg, self._wg_eval[a : rows + 1], self._eta[a : rows + 1]
+        D = self.blade.mixed_derivatives(xg[:-1, None], eta[None, :])  # (n_xi, rows-a+1, 3, 3, 3)
         D = np.concatenate([D, D[:1]], axis=0)
         dw = -2.0 * wg_eval[None, :, None]  # dη/dw
         F = D[..., 0, 0, :]
@@ -192,8 +207,8 @@ class BladeCache:
         G[2, 0], G[3, 0], G[2, 1], G[3, 1] = fx[0], fx[1], fx[2], fx[3]
         G[0, 2], G[1, 2], G[0, 3], G[1, 3] = fw[0], fw[1], fw[2], fw[3]
         G[2, 2], G[3, 2], G[2, 3], G[3, 3] = fxw[0], fxw[1], fxw[2], fxw[3]
-        C = np.einsum("ai,ijxyk,bj->xyabk", self._H, G, self._H)
-        self.coef = np.ascontiguousarray(C)  # (n_xi, n_w, 4, 4, 3)
+        self.coef[:, a:rows] = np.einsum("ai,ijxyk,bj->xyabk", self._H, G, self._H)
+        self.rows = rows
 
     def derivatives(self, p, order: int = 1) -> np.ndarray:
         """b, b_ξ, b_η of the surrogate at p (n, 2), in the layout of
@@ -205,6 +220,8 @@ class BladeCache:
         s = x - i
         y = np.minimum(w, self.w_max) / self.hw
         j = np.minimum(y.astype(np.intp), self.n_w - 1)
+        if j.size and j.max() >= self.rows:
+            self._build_rows(j.max() + 1 + CACHE_ROW_MARGIN)
         r = y - j
         C = self.coef[i, j]
         S, dS, Rr, dR = _powers(s), _power_derivatives(s), _powers(r), _power_derivatives(r)
