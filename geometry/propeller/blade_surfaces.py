@@ -99,8 +99,12 @@ def common_knots(blade, curves, tolerance: float, report: dict | None = None):
     the control points (K, n, 3) and blade parameters at the Greville abscissae (K, n, 2)
     of every curve. tolerance: metres."""
     interior = _symmetric(np.array(INITIAL_KNOTS))
+    # every parameter evaluated so far (points and blade parameters of all curves): a
+    # round evaluates only the Greville abscissae and samples it has not seen (knot
+    # insertion leaves most of them in place)
     cache_t = np.empty(0)
     cache_X = np.empty((len(curves), 0, 3))
+    cache_P = np.empty((len(curves), 0, 2))
     rounds = 0
     while True:
         rounds += 1
@@ -109,19 +113,22 @@ def common_knots(blade, curves, tolerance: float, report: dict | None = None):
         breaks = np.unique(U)
         local = (np.arange(1, SAMPLES_PER_SPAN) / SAMPLES_PER_SPAN)
         ts = (breaks[:-1, None] + np.diff(breaks)[:, None] * local[None, :]).ravel()
-        new = ~np.isin(ts, cache_t)
-        # one evaluation of the curves per round: the Greville abscissae and the new samples
-        Xa, Pa = evaluate_curves(blade, curves, np.concatenate([g, ts[new]]))
-        Xg, Pg = Xa[:, : g.size], Pa[:, : g.size]
+        wanted = np.concatenate([g, ts])
+        new = np.unique(wanted[~np.isin(wanted, cache_t)])
+        if new.size:
+            Xa, Pa = evaluate_curves(blade, curves, new)
+            cache_t = np.concatenate([cache_t, new])
+            cache_X = np.concatenate([cache_X, Xa], axis=1)
+            cache_P = np.concatenate([cache_P, Pa], axis=1)
+            order = np.argsort(cache_t)
+            cache_t, cache_X, cache_P = cache_t[order], cache_X[:, order], cache_P[:, order]
+        ig = np.searchsorted(cache_t, g)
+        Xg, Pg = cache_X[:, ig], cache_P[:, ig]
         C = fit_rows(U, Xg)
-        if np.any(new):
-            cache_t = np.concatenate([cache_t, ts[new]])
-            cache_X = np.concatenate([cache_X, Xa[:, g.size :]], axis=1)
-        order = np.argsort(cache_t)
-        cache_t, cache_X = cache_t[order], cache_X[:, order]
         F = cache_X[:, np.searchsorted(cache_t, ts)]
-        M = _collocation(U, ts)
-        S = np.einsum("tn,knd->ktd", M, C)
+        # the fitted curves at the samples (only compared with the tolerance)
+        K = len(curves)
+        S = np.moveaxis((_collocation(U, ts) @ np.moveaxis(C, 0, 1).reshape(C.shape[1], K * 3)).reshape(ts.size, K, 3), 1, 0)
         dev = np.linalg.norm(F - S, axis=2).max(axis=0).reshape(len(breaks) - 1, SAMPLES_PER_SPAN - 1).max(axis=1)
         failing = dev > tolerance
         if not np.any(failing):

@@ -574,11 +574,14 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
 
 
 def _check_orientation(blade, pairs: dict) -> None:
-    """S_u × S_v must point out of the blade on all five surfaces (Hally Eq. 1)."""
-    for name, pair in pairs.items():
-        u = np.array([0.3, 0.5, 0.7])
-        S, P = pair.surface, pair.parameters
-        n_s = S.normal(u, u)
-        n_b = blade.normal(P.evaluate(u, u)[:, 0], np.clip(P.evaluate(u, u)[:, 1], blade.eta_min, 1 - 1e-9))
-        if np.any(np.einsum("ij,ij->i", n_s, n_b) <= 0):
+    """S_u × S_v must point out of the blade on all five surfaces (Hally Eq. 1): three
+    points each, the blade's normals at all of them in one evaluation."""
+    u = np.array([0.3, 0.5, 0.7])
+    names = list(pairs)
+    n_s = np.concatenate([pairs[k].surface.normal(u, u) for k in names])
+    P = np.concatenate([pairs[k].parameters.evaluate(u, u) for k in names])
+    n_b = blade.normal(P[:, 0], np.clip(P[:, 1], blade.eta_min, 1 - 1e-9))
+    bad = np.einsum("ij,ij->i", n_s, n_b).reshape(len(names), u.size) <= 0
+    for name, row in zip(names, bad):
+        if np.any(row):
             raise GeometryError(f"the {name} surface is not oriented outwards (internal error)")
