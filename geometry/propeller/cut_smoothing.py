@@ -213,16 +213,6 @@ def stable_strength_scale(W: np.ndarray, beta: np.ndarray) -> float:
     return min(1.0, 2.0 / (STABILITY_MARGIN * rho))
 
 
-def _sweeps(Y: np.ndarray, weights: np.ndarray, coef: np.ndarray, count: int) -> np.ndarray:
-    """``count`` sweeps y_i += coef_i Σ_k weights_ik y_{i-2+k} on samples 2..N-3 (the banded
-    form of :func:`filter_matrix`; weights (N-4, 5), coef (N-4,))."""
-    Y = np.array(Y, dtype=np.float64)
-    w = [(coef * weights[:, k])[:, None] for k in range(5)]
-    for _ in range(int(count)):
-        Y[2:-2] += w[0] * Y[:-4] + w[1] * Y[1:-3] + w[2] * Y[2:-2] + w[3] * Y[3:-1] + w[4] * Y[4:]
-    return Y
-
-
 @dataclass(frozen=True, eq=False)
 class SmoothedCut:
     """A cut after Hally §7: ``curve`` (the exact cut blended into the spline of the
@@ -376,7 +366,8 @@ def smooth_cuts(blade, cuts, tip_distances, *, d_t: float, d_e: float, strength:
         work.append((k, t, Y0, beta, in_cut, coef, bands))
     if not work:
         return results
-    # --- the sweeps of every cut on one array (Eq. 29 in arclength, :func:`_sweeps`)
+    # --- the sweeps of every cut on one array: y_i += coef_i Σ_k band_ik y_{i-2+k} on the
+    # interior samples (Eq. 29 in arclength, the banded form of :func:`filter_matrix`)
     Y0cat = np.concatenate([w[2] for w in work])
     starts = np.cumsum([0] + [len(w[1]) for w in work])
     weights = np.zeros((5, len(Y0cat) - 4, 1))

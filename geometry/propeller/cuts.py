@@ -126,27 +126,6 @@ def cut_parameters(a: np.ndarray, m: int) -> np.ndarray:
     return t
 
 
-def _powers(s: np.ndarray) -> np.ndarray:
-    """(1, s, s², s³) as columns (n, 4) (filled in place: np.stack costs more than the
-    arithmetic at the march's sizes)."""
-    out = np.empty((s.size, 4))
-    out[:, 0] = 1.0
-    out[:, 1] = s
-    out[:, 2] = s * s
-    out[:, 3] = out[:, 2] * s
-    return out
-
-
-def _power_derivatives(s: np.ndarray) -> np.ndarray:
-    """(0, 1, 2s, 3s²) as columns (n, 4)."""
-    out = np.empty((s.size, 4))
-    out[:, 0] = 0.0
-    out[:, 1] = 1.0
-    out[:, 2] = 2 * s
-    out[:, 3] = 3 * s * s
-    return out
-
-
 def _fail(label, p, what):
     return GeometryError(
         f"blade cut {label}: {what} at ξ = {p[0]:.6g}, η = {p[1]:.6g} "
@@ -214,17 +193,29 @@ class BladeCache:
         """b, b_ξ, b_η of the surrogate at p (n, 2), in the layout of
         ``BladeSurface.derivatives(order=1)``: (n, 2, 2, 3)."""
         xi = np.mod(p[:, 0], 1.0)
-        w = np.sqrt(np.clip(1.0 - p[:, 1], ETA_TIP_GUARD, None))
+        w = np.sqrt(np.maximum(1.0 - p[:, 1], ETA_TIP_GUARD))
         x = xi / self.hx
         i = np.minimum(x.astype(np.intp), self.n_xi - 1)
-        s = x - i
         y = np.minimum(w, self.w_max) / self.hw
         j = np.minimum(y.astype(np.intp), self.n_w - 1)
         if j.size and j.max() >= self.rows:
             self._build_rows(j.max() + 1 + CACHE_ROW_MARGIN)
-        r = y - j
         C = self.coef[i, j]
-        S, dS, Rr, dR = _powers(s), _power_derivatives(s), _powers(r), _power_derivatives(r)
+        # the power bases (1, s, s², s³) and (0, 1, 2s, 3s²) for s (ξ) and r (w), both at once
+        sr = np.empty((2, len(p)))
+        np.subtract(x, i, out=sr[0])
+        np.subtract(y, j, out=sr[1])
+        P = np.empty((2, len(p), 4))
+        P[..., 0] = 1.0
+        P[..., 1] = sr
+        P[..., 2] = sr * sr
+        P[..., 3] = P[..., 2] * sr
+        Pd = np.empty((2, len(p), 4))
+        Pd[..., 0] = 0.0
+        Pd[..., 1] = 1.0
+        Pd[..., 2] = 2 * sr
+        Pd[..., 3] = 3 * sr * sr
+        S, dS, Rr, dR = P[0], Pd[0], P[1], Pd[1]
         out = np.zeros((len(p), order + 1, order + 1, 3))
         CR = np.einsum("nabk,nb->nak", C, Rr)
         out[:, 0, 0] = np.einsum("na,nak->nk", S, CR)
@@ -259,8 +250,9 @@ def chart_derivatives(deriv, eta_min):
         c = np.array(c, dtype=np.float64)
         r2 = np.sum(c * c, axis=1)
         big = r2 > r_max2
-        c[big] *= np.sqrt(r_max2 / r2[big])[:, None]
-        r2 = np.clip(np.minimum(r2, r_max2), ETA_TIP_GUARD, None)
+        if big.any():
+            c[big] *= np.sqrt(r_max2 / r2[big])[:, None]
+        r2 = np.maximum(np.minimum(r2, r_max2), ETA_TIP_GUARD)
         p = from_tip_chart(c)
         D = deriv(p, 1)
         X, Y = c[:, 0:1], c[:, 1:2]

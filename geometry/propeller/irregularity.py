@@ -174,14 +174,16 @@ def measure_windows(blade, cuts, d_e: float) -> list[np.ndarray]:
 
 def _spline_node_derivatives(Y: np.ndarray):
     """First and second derivatives at the nodes of the not-a-knot cubic interpolating
-    spline (the spline of ``make_interp_spline(t, Y, k=3)``) through Y (n, D) at evenly
+    spline (the spline of ``make_interp_spline(t, Y, k=3)``) through Y (n, ...) at evenly
     spaced parameters, unit spacing: M (second derivatives) from the tridiagonal
     equations M_{i-1} + 4M_i + M_{i+1} = 6 δ²y_i and the not-a-knot ends
     M_0 - 2M_1 + M_2 = 0, M_{n-3} - 2M_{n-2} + M_{n-1} = 0 (one banded solve for all
     columns)."""
     from scipy.linalg import solve_banded
 
-    n = Y.shape[0]
+    shape = Y.shape
+    n = shape[0]
+    Y = Y.reshape(n, -1)
     ab = np.zeros((5, n))
     # ab[2 + i - j, j] = A[i, j]
     ab[2, 1:-1] = 4.0
@@ -189,15 +191,17 @@ def _spline_node_derivatives(Y: np.ndarray):
     ab[3, :-2] = 1.0  # A[i, i-1], i = 1..n-2
     ab[2, 0], ab[1, 1], ab[0, 2] = 1.0, -2.0, 1.0  # row 0
     ab[4, n - 3], ab[3, n - 2], ab[2, n - 1] = 1.0, -2.0, 1.0  # row n-1
-    ab[1, 1] = -2.0
-    ab[3, n - 2] = -2.0
-    rhs = np.zeros_like(Y)
-    rhs[1:-1] = 6.0 * (Y[:-2] - 2.0 * Y[1:-1] + Y[2:])
+    rhs = np.empty_like(Y)
+    rhs[0] = rhs[-1] = 0.0
+    np.subtract(Y[:-2], 2.0 * Y[1:-1], out=rhs[1:-1])
+    rhs[1:-1] += Y[2:]
+    rhs[1:-1] *= 6.0
     M = solve_banded((2, 2), ab, rhs, overwrite_ab=True, overwrite_b=True, check_finite=False)
     d1 = np.empty_like(Y)
-    d1[:-1] = (Y[1:] - Y[:-1]) - (2.0 * M[:-1] + M[1:]) / 6.0
+    np.subtract(Y[1:], Y[:-1], out=d1[:-1])
+    d1[:-1] -= (2.0 * M[:-1] + M[1:]) / 6.0
     d1[-1] = (Y[-1] - Y[-2]) + (M[-2] + 2.0 * M[-1]) / 6.0
-    return d1, M
+    return d1.reshape(shape), M.reshape(shape)
 
 
 def curve_excess_uniform(X) -> np.ndarray:
@@ -208,23 +212,25 @@ def curve_excess_uniform(X) -> np.ndarray:
     round-off)."""
     X = np.asarray(X, dtype=np.float64)
     m, n, _ = X.shape
-    Y = np.moveaxis(X, 0, 1).reshape(n, m * 3)
-    d1, d2 = _spline_node_derivatives(Y)
-    d1 = np.moveaxis(d1.reshape(n, m, 3), 1, 0)
-    d2 = np.moveaxis(d2.reshape(n, m, 3), 1, 0)
-    c = np.cross(d1, d2)
-    nvec = np.sum(c, axis=1)
-    nn = np.linalg.norm(nvec, axis=1)
+    d1, d2 = _spline_node_derivatives(np.ascontiguousarray(np.moveaxis(X, 0, 1)))  # (n, m, 3)
+    ax, ay, az = d1[..., 0], d1[..., 1], d1[..., 2]
+    bx, by, bz = d2[..., 0], d2[..., 1], d2[..., 2]
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx  # c' x c'', (n, m)
+    nx, ny, nz = cx.sum(axis=0), cy.sum(axis=0), cz.sum(axis=0)
+    nn = np.sqrt(nx * nx + ny * ny + nz * nz)
     out = np.zeros(m)
     ok = nn > 0.0
+    inv = 1.0 / np.where(ok, nn, 1.0)
+    speed2 = ax * ax + ay * ay + az * az
     with np.errstate(divide="ignore", invalid="ignore"):
-        k = np.einsum("mnj,mj->mn", c, nvec / np.where(ok, nn, 1.0)[:, None]) / np.linalg.norm(d1, axis=2) ** 3
-    finite = np.all(np.isfinite(k), axis=1)
-    kk = k[ok & finite]
+        k = (cx * (nx * inv) + cy * (ny * inv) + cz * (nz * inv)) / (speed2 * np.sqrt(speed2))  # (n, m)
+    finite = np.all(np.isfinite(k), axis=0)
+    use = ok & finite
+    kk = k[:, use]
     if kk.size:
-        tv = np.sum(np.abs(np.diff(kk, axis=1)), axis=1)
-        pk = kk[np.arange(len(kk)), np.argmax(np.abs(kk), axis=1)]
-        out[ok & finite] = np.maximum(0.0, tv - np.abs(pk - kk[:, 0]) - np.abs(pk - kk[:, -1]))
+        tv = np.sum(np.abs(np.diff(kk, axis=0)), axis=0)
+        pk = kk[np.argmax(np.abs(kk), axis=0), np.arange(kk.shape[1])]
+        out[use] = np.maximum(0.0, tv - np.abs(pk - kk[0]) - np.abs(pk - kk[-1]))
     for i in np.flatnonzero(ok & ~finite):
-        out[i] = excess_curvature_variation(k[i])
+        out[i] = excess_curvature_variation(k[:, i])
     return out
