@@ -253,17 +253,20 @@ def chart_derivatives(deriv, eta_min):
         if big.any():
             c[big] *= np.sqrt(r_max2 / r2[big])[:, None]
         r2 = np.maximum(np.minimum(r2, r_max2), ETA_TIP_GUARD)
-        p = from_tip_chart(c)
+        # from_tip_chart(c) (ξ_ref = 0), written out: the same operations, fewer calls
+        p = np.empty_like(c)
+        p[:, 0] = np.mod(np.arctan2(c[:, 1], c[:, 0]) / (2.0 * np.pi) + 0.5, 1.0) - 0.5
+        p[:, 1] = 1.0 - (c[:, 0] ** 2 + c[:, 1] ** 2)
         D = deriv(p, 1)
         X, Y = c[:, 0:1], c[:, 1:2]
         bxi, beta = D[:, 1, 0], D[:, 0, 1]
         k = 1.0 / (2.0 * np.pi * r2[:, None])
-        out = np.empty_like(D)
-        out[:, 0, 0] = D[:, 0, 0]
-        out[:, 1, 0] = -Y * k * bxi - 2.0 * X * beta
-        out[:, 0, 1] = X * k * bxi - 2.0 * Y * beta
-        out[:, 1, 1] = 0.0
-        return out
+        b_X = -Y * k * bxi - 2.0 * X * beta
+        b_Y = X * k * bxi - 2.0 * Y * beta
+        D[:, 1, 0] = b_X
+        D[:, 0, 1] = b_Y
+        D[:, 1, 1] = 0.0
+        return D
 
     return evaluate
 
