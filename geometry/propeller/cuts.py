@@ -282,6 +282,9 @@ class _PlaneSolver:
         self.eta_min = eta_min
         self.r_max2 = 1.0 - eta_min
         self.tol = PLANE_TOL * radius
+        #: (b_X·n̂, b_Y·n̂) at the points of the last :meth:`solve` where known (NaN elsewhere)
+        self.gradient = None
+        self.last_gradient = None
 
     def residual(self, p, idx, order=1):
         """f = (b(p) - x_0)·n̂ (Eq. 16), its chart gradient (b_X·n̂, b_Y·n̂), and the
@@ -299,6 +302,7 @@ class _PlaneSolver:
         s = np.zeros(len(idx))
         ok = np.zeros(len(idx), dtype=bool)
         p = trial.copy()
+        grad = np.full((len(idx), 2), np.nan)  # (b_X·n̂, b_Y·n̂) where converged
         todo = np.arange(len(idx))
         for _ in range(NEWTON_MAX_ITERATIONS):
             if todo.size == 0:
@@ -308,6 +312,7 @@ class _PlaneSolver:
             p[todo] = pt
             conv = np.abs(f) < self.tol
             ok[todo[conv]] = True
+            grad[todo[conv]] = g[conv]
             todo, f, g = todo[~conv], f[~conv], g[~conv]
             fp = np.einsum("ij,ij->i", g, m[todo])
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -316,6 +321,7 @@ class _PlaneSolver:
             s[todo] += np.where(bad, 0.0, ds)
             todo = todo[~bad]
         ok &= np.sum(p * p, axis=1) <= self.r_max2
+        self.last_gradient = grad
         return p, ok
 
     def xi_search(self, trial, idx):
@@ -337,6 +343,7 @@ class _PlaneSolver:
             with np.errstate(divide="ignore", invalid="ignore"):
                 dxi = np.where(ok, 0.0, -f / fp)
             xi += np.clip(np.where(np.isfinite(dxi), dxi, 0.0), -0.05, 0.05)
+        self.last_gradient = g  # at the p returned (the last evaluation)
         return p, ok & (np.abs(xi - xi0) < XI_SEARCH_MAX_SHIFT)
 
     def bisection(self, trial, m, idx):
@@ -367,12 +374,21 @@ class _PlaneSolver:
         return p, ok
 
     def solve(self, trial, m, idx, labels, counts, per_item=None):
-        """Newton (Eq. 20), then the ξ-search (Eq. 21), then bisection (Eq. 22)."""
+        """Newton (Eq. 20), then the ξ-search (Eq. 21), then bisection (Eq. 22).
+        ``self.gradient``: (b_X·n̂, b_Y·n̂) at the returned points where the search that
+        found them evaluated it there (NaN elsewhere)."""
+        self.last_gradient = None
         p, ok = self.newton_line(trial, m, idx)
+        grad = self.last_gradient
+        self.gradient = grad = np.full((len(idx), 2), np.nan) if grad is None else grad
         if np.all(ok):
             return p
+        grad[~ok] = np.nan
         bad = np.flatnonzero(~ok)
+        self.last_gradient = None
         pb, okb = self.xi_search(trial[bad], idx[bad])
+        if self.last_gradient is not None:
+            grad[bad[okb]] = self.last_gradient[okb]
         p[bad[okb]] = pb[okb]
         counts["xi_search"] += int(okb.sum())
         if per_item is not None:
@@ -463,7 +479,11 @@ def _march(solver, blade, start, end, labels, counts):
         active = idx[~passed]
         if active.size == 0:
             break
-        f, g, D = solver.residual(cur[active], active)
+        # the gradient at the new points: the corrector evaluated it there already
+        g = solver.gradient[~passed]
+        redo = np.flatnonzero(np.isnan(g[:, 0]))
+        if redo.size:
+            g[redo] = solver.residual(cur[active[redo]], active[redo])[1]
     else:
         h = int(active[0])
         raise _fail(labels[h], cur[h], f"no arrival at the edge point after {MARCH_MAX_STEPS} steps")
