@@ -249,6 +249,13 @@ class BlendedOffset:
 
     def __init__(self, blade, parameters, spline, disp, weight):
         self.blade, self.parameters, self.spline, self.disp, self.weight = blade, parameters, spline, disp, weight
+        #: the three splines as one (columns w, d, S) when they share their knots: one
+        #: evaluation gives each column's values of its own spline
+        self.joint = None
+        if (np.array_equal(spline.t, disp.t) and np.array_equal(spline.t, weight.t)
+                and spline.k == disp.k == weight.k and np.ndim(weight.c) == 1):
+            self.joint = BSpline.construct_fast(
+                spline.t, np.concatenate([np.asarray(weight.c)[:, None], disp.c, spline.c], axis=1), spline.k)
 
     def __call__(self, t):
         t = np.asarray(t, dtype=np.float64)
@@ -256,13 +263,18 @@ class BlendedOffset:
 
     def on_exact(self, t, X):
         """The displacement at t; X: the exact cut b(p(t)) there when already known."""
-        d = self.disp(t)
-        w = np.clip(self.weight(t), 0.0, 1.0)
+        if self.joint is not None:
+            V = self.joint(t)
+            w, d, S = np.clip(V[:, 0], 0.0, 1.0), V[:, 1:4], V[:, 4:7]
+        else:
+            d = self.disp(t)
+            w = np.clip(self.weight(t), 0.0, 1.0)
+            S = None
         out = np.array(d)
         on = w > 0.0
         if np.any(on):
             Xo = blade_points(self.blade, self.parameters.parameters(t[on])) if X is None else X[on]
-            out[on] = d[on] + w[on, None] * (self.spline(t[on]) - Xo - d[on])
+            out[on] = d[on] + w[on, None] * ((self.spline(t[on]) if S is None else S[on]) - Xo - d[on])
         return out
 
 
