@@ -566,7 +566,12 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
             report["warnings"].append(
                 f"inside the smoothing zone the surfaces depart from the blade by up to {dev['max_inside']:.3g} m "
                 f"({dev['max_inside'] / D:.3g} D), more than the bound {SMOOTHING_ZONE_BOUND * R:.3g} m")
-        report["shared_edges"] = [{k: v for k, v in e.items() if k != "angles"} for e in shared_edge_report(surfaces)]
+        # SHARED_EDGES names the surfaces by their place (pressure_central at ξ < 1/2, the
+        # pressure side of a right-handed blade); a left-handed blade's are swapped above
+        layout = dict(surfaces)
+        if blade.hand < 0:
+            layout["pressure_central"], layout["suction_central"] = surfaces["suction_central"], surfaces["pressure_central"]
+        report["shared_edges"] = [{k: v for k, v in e.items() if k != "angles"} for e in shared_edge_report(layout)]
         lap("measure")
     report["times_s"]["total"] = sum(v for k, v in times.items() if k != "total")
     return SmoothedBlade(**surfaces, parameter_surfaces=params, curves=curves, overlays=overlays, report=report,
