@@ -3,14 +3,36 @@ default settings: median time per stage and in total (issue 5: the blade part we
 2 s on one core; the hub sector and IGES take the rest). Baseline measured in the same
 run: one evaluation of b and its first derivatives at 1000 points (the unit of cost the
 marching and Newton stages pay per call).
+
+``figures()`` (``make bench``, issue 22): the smoothing core alone, cold (TOML -> model ->
+``smooth_blade``, the marching surrogate rebuilt as after a geometry edit), on this
+checkout and on the main commit before issue 22's smoothing-core work (BASELINE_COMMIT,
+unpacked from git into a temporary folder and imported as a second package), timed
+alternately so that both see the same load; without git the baseline is left out.
 """
 from __future__ import annotations
 
+import importlib
+import importlib.util
+import os
+import pathlib
+import shutil
 import statistics
+import subprocess
+import sys
+import tempfile
+import time
 
-import numpy as np
+for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
 
-from common import ROOT, load_checkout, median_time, report
+import numpy as np  # noqa: E402
+
+from common import ROOT, load_checkout, median_time, report  # noqa: E402
+
+#: main before issue 22's smoothing-core work (session 5).
+BASELINE_COMMIT = "7349c2f"
+CORE_REPEAT = 9
 
 REPEAT = 5
 STAGES = ("corners", "side_curves", "cuts_and_edge_curves", "common_knots", "surfaces")
@@ -44,5 +66,70 @@ def main() -> dict:
     return results
 
 
+def _load_commit(commit: str, tmp: pathlib.Path, name: str):
+    """The package at ``commit`` imported as ``name``, or None without git."""
+    if shutil.which("git") is None:
+        return None
+    target = tmp / name
+    target.mkdir()
+    try:
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", commit], check=True,
+                                 capture_output=True).stdout
+        subprocess.run(["tar", "-x", "-C", str(target)], input=archive, check=True, capture_output=True)
+    except (subprocess.CalledProcessError, OSError):
+        return None
+    spec = importlib.util.spec_from_file_location(name, target / "__init__.py",
+                                                  submodule_search_locations=[str(target)])
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return name
+
+
+def core_times(case: str = "dtmb4119", repeat: int = CORE_REPEAT) -> dict:
+    """Median cold smooth_blade time (s) per package, this checkout and the baseline,
+    timed alternately."""
+    load_checkout()
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix="bench_core_"))
+    try:
+        packages = ["bladesmith"]
+        base = _load_commit(BASELINE_COMMIT, tmp, "bladesmith_core_baseline")
+        if base is not None:
+            packages.append(base)
+        path = ROOT / "data" / "propellers" / f"{case}.toml"
+        runs = {}
+        for pkg in packages:
+            prop = importlib.import_module(pkg + ".geometry.propeller")
+
+            def run(prop=prop):
+                model = prop.Propeller.from_toml(path).build()
+                model.blade_hub_intersection  # part of the model, not of smoothing
+                start = time.perf_counter()
+                prop.smooth_blade(model, measure=False)
+                return time.perf_counter() - start
+
+            run()
+            runs[pkg] = run
+        times = {k: [] for k in runs}
+        for _ in range(repeat):
+            for k, fn in runs.items():
+                times[k].append(fn())
+        return {("new" if k == "bladesmith" else "baseline"): statistics.median(v) for k, v in times.items()}
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def figures() -> list[dict]:
+    t = core_times()
+    new = t["new"]
+    baseline = ""
+    if "baseline" in t:
+        baseline = f"{t['baseline'] * 1e3:.0f} ms at {BASELINE_COMMIT} in the same run ({new / t['baseline']:.2f}x)"
+    return [{"figure": "Hally smoothing core, DTMB 4119, model -> 5 surfaces, cold, one core", "value": new * 1e3,
+             "unit": "ms", "baseline": baseline, "goal": "<= 30 ms"}]
+
+
 if __name__ == "__main__":
     main()
+    for row in figures():
+        print(f"\n  {row['figure']}: {row['value']:.1f} {row['unit']} (goal {row['goal']}); baseline: {row['baseline']}")

@@ -99,8 +99,14 @@ def common_knots(blade, curves, tolerance: float, report: dict | None = None):
     the control points (K, n, 3) and blade parameters at the Greville abscissae (K, n, 2)
     of every curve. tolerance: metres."""
     interior = _symmetric(np.array(INITIAL_KNOTS))
+    # every parameter evaluated so far, with the points and blade parameters of all
+    # curves there, one row per parameter ((t, curve, xyz): a round appends rows and
+    # gathers rows): a round evaluates only the Greville abscissae and samples it has not
+    # seen (knot insertion leaves most of them in place)
+    K = len(curves)
     cache_t = np.empty(0)
-    cache_X = np.empty((len(curves), 0, 3))
+    cache_X = np.empty((0, K, 3))
+    cache_P = np.empty((0, K, 2))
     rounds = 0
     while True:
         rounds += 1
@@ -109,20 +115,26 @@ def common_knots(blade, curves, tolerance: float, report: dict | None = None):
         breaks = np.unique(U)
         local = (np.arange(1, SAMPLES_PER_SPAN) / SAMPLES_PER_SPAN)
         ts = (breaks[:-1, None] + np.diff(breaks)[:, None] * local[None, :]).ravel()
-        new = ~np.isin(ts, cache_t)
-        # one evaluation of the curves per round: the Greville abscissae and the new samples
-        Xa, Pa = evaluate_curves(blade, curves, np.concatenate([g, ts[new]]))
-        Xg, Pg = Xa[:, : g.size], Pa[:, : g.size]
-        C = fit_rows(U, Xg)
-        if np.any(new):
-            cache_t = np.concatenate([cache_t, ts[new]])
-            cache_X = np.concatenate([cache_X, Xa[:, g.size :]], axis=1)
+        wanted = np.concatenate([g, ts])
+        new = np.unique(wanted[~np.isin(wanted, cache_t)])
+        if new.size:
+            Xa, Pa = evaluate_curves(blade, curves, new)
+            cache_t = np.concatenate([cache_t, new])
+            cache_X = np.concatenate([cache_X, np.swapaxes(Xa, 0, 1)])
+            cache_P = np.concatenate([cache_P, np.swapaxes(Pa, 0, 1)])
         order = np.argsort(cache_t)
-        cache_t, cache_X = cache_t[order], cache_X[:, order]
-        F = cache_X[:, np.searchsorted(cache_t, ts)]
-        M = _collocation(U, ts)
-        S = np.einsum("tn,knd->ktd", M, C)
-        dev = np.linalg.norm(F - S, axis=2).max(axis=0).reshape(len(breaks) - 1, SAMPLES_PER_SPAN - 1).max(axis=1)
+        sorted_t = cache_t[order]
+
+        def rows(t):
+            return order[np.searchsorted(sorted_t, t)]
+
+        ig = rows(g)
+        # the fit of every curve at the Greville abscissae (fit_rows, on the same matrix)
+        C = interpolate_at(U, DEGREE, g, cache_X[ig].reshape(g.size, K * 3)).control_points
+        F = cache_X[rows(ts)]  # (samples, curves, 3)
+        # the fitted curves at the samples (only compared with the tolerance)
+        S = (_collocation(U, ts) @ C).reshape(ts.size, K, 3)
+        dev = np.linalg.norm(F - S, axis=2).max(axis=1).reshape(len(breaks) - 1, SAMPLES_PER_SPAN - 1).max(axis=1)
         failing = dev > tolerance
         if not np.any(failing):
             break
@@ -136,6 +148,8 @@ def common_knots(blade, curves, tolerance: float, report: dict | None = None):
     if report is not None:
         report.update(rounds=rounds, n_knots=len(U), n_control=len(U) - DEGREE - 1,
                       max_curve_deviation=float(dev.max()), curves=len(curves))
+    C = np.moveaxis(np.asarray(C).reshape(g.size, K, 3), 1, 0)
+    Pg = np.moveaxis(cache_P[ig], 1, 0)
     return U, C, Pg
 
 

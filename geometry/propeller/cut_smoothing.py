@@ -213,16 +213,6 @@ def stable_strength_scale(W: np.ndarray, beta: np.ndarray) -> float:
     return min(1.0, 2.0 / (STABILITY_MARGIN * rho))
 
 
-def _sweeps(Y: np.ndarray, weights: np.ndarray, coef: np.ndarray, count: int) -> np.ndarray:
-    """``count`` sweeps y_i += coef_i Σ_k weights_ik y_{i-2+k} on samples 2..N-3 (the banded
-    form of :func:`filter_matrix`; weights (N-4, 5), coef (N-4,))."""
-    Y = np.array(Y, dtype=np.float64)
-    w = [(coef * weights[:, k])[:, None] for k in range(5)]
-    for _ in range(int(count)):
-        Y[2:-2] += w[0] * Y[:-4] + w[1] * Y[1:-3] + w[2] * Y[2:-2] + w[3] * Y[3:-1] + w[4] * Y[4:]
-    return Y
-
-
 @dataclass(frozen=True, eq=False)
 class SmoothedCut:
     """A cut after Hally §7: ``curve`` (the exact cut blended into the spline of the
@@ -259,6 +249,13 @@ class BlendedOffset:
 
     def __init__(self, blade, parameters, spline, disp, weight):
         self.blade, self.parameters, self.spline, self.disp, self.weight = blade, parameters, spline, disp, weight
+        #: the three splines as one (columns w, d, S) when they share their knots: one
+        #: evaluation gives each column's values of its own spline
+        self.joint = None
+        if (np.array_equal(spline.t, disp.t) and np.array_equal(spline.t, weight.t)
+                and spline.k == disp.k == weight.k and np.ndim(weight.c) == 1):
+            self.joint = BSpline.construct_fast(
+                spline.t, np.concatenate([np.asarray(weight.c)[:, None], disp.c, spline.c], axis=1), spline.k)
 
     def __call__(self, t):
         t = np.asarray(t, dtype=np.float64)
@@ -266,13 +263,18 @@ class BlendedOffset:
 
     def on_exact(self, t, X):
         """The displacement at t; X: the exact cut b(p(t)) there when already known."""
-        d = self.disp(t)
-        w = np.clip(self.weight(t), 0.0, 1.0)
+        if self.joint is not None:
+            V = self.joint(t)
+            w, d, S = np.clip(V[:, 0], 0.0, 1.0), V[:, 1:4], V[:, 4:7]
+        else:
+            d = self.disp(t)
+            w = np.clip(self.weight(t), 0.0, 1.0)
+            S = None
         out = np.array(d)
         on = w > 0.0
         if np.any(on):
             Xo = blade_points(self.blade, self.parameters.parameters(t[on])) if X is None else X[on]
-            out[on] = d[on] + w[on, None] * (self.spline(t[on]) - Xo - d[on])
+            out[on] = d[on] + w[on, None] * ((self.spline(t[on]) if S is None else S[on]) - Xo - d[on])
         return out
 
 
@@ -288,85 +290,188 @@ def smooth_cut(blade, cut, tip_distance: float, *, d_t: float, d_e: float, stren
     variation in the window (:mod:`.irregularity`), among those
     whose largest displacement stays within ``bound`` (m): more sweeps never leave the cut
     rougher than fewer, nor move it beyond the bound. When the guard keeps fewer than n
-    sweeps, ``stopped`` says why, with the figures. n = 0 leaves the cut exact."""
-    from .irregularity import curve_excess_many, measure_window
+    sweeps, ``stopped`` says why, with the figures. n = 0 leaves the cut exact.
+    (:func:`smooth_cuts` with one cut.)"""
+    return smooth_cuts(blade, [cut], [tip_distance], d_t=d_t, d_e=d_e, strength=strength, iterations=iterations,
+                       spacing=spacing, edge_spacing=edge_spacing, bound=bound)[0]
 
-    x0, x1, x2 = cut.points
-    t = edge_distribution(float(np.linalg.norm(x1 - x0)), float(np.linalg.norm(x1 - x2)), spacing, edge_spacing)
-    Y0 = blade_points(blade, cut.curve.parameters(t))
-    in_cut = bump(np.linalg.norm(Y0 - x1, axis=1) / d_e)
-    # β falls smoothly to 0 towards the ends, which stay on c_9/c_10 (c_5..c_8): a pinned
-    # end inside the window would put a kink into the cut next to it
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(Y0, axis=0), axis=1))])
-    to_end = np.minimum(s, s[-1] - s)
-    taper = 1.0 - bump(to_end / (END_TAPER_FRACTION * min(s[len(t) // 2], s[-1] - s[len(t) // 2])))
-    beta = strength * bump(tip_distance / d_t) * in_cut * taper  # Eq. 30
-    beta[[0, 1, -2, -1]] = 0.0
-    n = int(iterations)
-    if n == 0 or not np.any(beta > 0):
-        return SmoothedCut(curve=cut.curve, t=t, before=Y0, after=Y0, beta=beta, max_displacement=0.0)
-    W = fourth_difference_weights(s)
-    coef = stable_strength_scale(W, beta) * beta[2:-2] / 6.0
-    rows = np.arange(2, len(t) - 2)
-    bands = W[rows[:, None], rows[:, None] + np.arange(-2, 3)[None, :]]
-    tw = measure_window(blade, cut, d_e)
-    Xw = blade_points(blade, cut.curve.parameters(tw))
-    weight = make_interp_spline(t, in_cut, k=3)
 
-    # the checkpoints' sweeps run in sequence; their curves are then splined and measured
-    # in one batch (the same splines and measure as one by one, without the per-call cost)
-    checkpoints, Ys, stop = [], [], None
-    Y, done = Y0, 0
+def _filter_bands(s: np.ndarray) -> np.ndarray:
+    """The non-zero band of :func:`fourth_difference_weights` (rows 2..N-3, columns
+    i-2..i+2): (N-4, 5), the same numbers without the dense matrix."""
+    N = s.size
+    i = np.arange(2, N - 2)
+    cols = i[:, None] + np.arange(-2, 3)[None, :]
+    nodes = s[cols]  # (m, 5)
+    diff = nodes[:, :, None] - nodes[:, None, :]
+    diff[:, np.arange(5), np.arange(5)] = 1.0
+    w = 1.0 / np.prod(diff, axis=2)
+    h = (nodes[:, 4] - nodes[:, 0]) / 4.0
+    return -24.0 * h[:, None] ** 4 * w
+
+
+def _strength_scale(bands: np.ndarray, beta: np.ndarray) -> float:
+    """:func:`stable_strength_scale` for the filter of ``bands`` (:func:`_filter_bands`).
+
+    The power iteration there estimates |B x| with |x| = 1, which cannot exceed the 2-norm
+    of B, and |B|_2 <= sqrt(|B|_1 |B|_inf). When that bound already keeps the estimate
+    below 2/STABILITY_MARGIN the factor is exactly 1 and the iteration is skipped (the
+    common case, Hally's nearly geometric samples); otherwise it runs as before."""
+    active = beta > 0
+    if not np.any(active):
+        return 1.0
+    N = beta.size
+    cols = np.arange(2, N - 2)[:, None] + np.arange(-2, 3)[None, :]
+    A = np.abs((beta[2:-2] / 6.0)[:, None] * bands) * (active[2:-2, None] & active[cols])
+    row = float(A.sum(axis=1).max())
+    col = float(np.bincount(cols.ravel(), weights=A.ravel(), minlength=N).max())
+    if math.sqrt(row * col) * STABILITY_MARGIN * (1.0 + 1e-9) < 2.0:
+        return 1.0
+    W = np.zeros((N, N))
+    W[np.arange(2, N - 2)[:, None], cols] = bands
+    return stable_strength_scale(W, beta)
+
+
+def _checkpoints(n: int) -> list[int]:
     levels = int(np.log(n) / np.log(GUARD_CHECKPOINT_RATIO)) + 2
-    for c in sorted({min(GUARD_CHECKPOINT_RATIO**k, n) for k in range(levels)}):
-        Y = _sweeps(Y, bands, coef, c - done)
+    return sorted({min(GUARD_CHECKPOINT_RATIO**k, n) for k in range(levels)})
+
+
+def smooth_cuts(blade, cuts, tip_distances, *, d_t: float, d_e: float, strength: float,
+                iterations: int, spacing: float, edge_spacing: float, bound: float | None = None) -> list[SmoothedCut]:
+    """:func:`smooth_cut` for several cuts at once: the same samples, filter, guard and
+    curves, cut by cut, with b evaluated once for all cuts at each stage, the filter
+    sweeps of all cuts run on one concatenated array (the samples next to the cuts'
+    ends are fixed, so no cut reads another), one interpolation per cut for its
+    splines, and the guard's curvature measured for every cut and checkpoint in one
+    banded solve (:func:`~.irregularity.curve_excess_uniform`)."""
+    from .irregularity import curve_excess_uniform, measure_windows
+
+    K = len(cuts)
+    n = int(iterations)
+    ts, pars = [], []
+    for cut in cuts:
+        x0, x1, x2 = cut.points
+        t = edge_distribution(float(np.linalg.norm(x1 - x0)), float(np.linalg.norm(x1 - x2)), spacing, edge_spacing)
+        ts.append(t)
+        pars.append(cut.curve.parameters(t))
+    Yall = blade_points(blade, np.concatenate(pars))
+    offsets = np.cumsum([0] + [t.size for t in ts])
+    results: list = [None] * K
+    work = []  # cuts the filter acts on: (k, t, Y0, beta, in_cut, coef, bands)
+    for k, (cut, t, a) in enumerate(zip(cuts, ts, tip_distances)):
+        x1 = cut.points[1]
+        Y0 = Yall[offsets[k] : offsets[k + 1]]
+        in_cut = bump(np.linalg.norm(Y0 - x1, axis=1) / d_e)
+        # β falls smoothly to 0 towards the ends, which stay on c_9/c_10 (c_5..c_8): a pinned
+        # end inside the window would put a kink into the cut next to it
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(Y0, axis=0), axis=1))])
+        to_end = np.minimum(s, s[-1] - s)
+        taper = 1.0 - bump(to_end / (END_TAPER_FRACTION * min(s[len(t) // 2], s[-1] - s[len(t) // 2])))
+        beta = strength * bump(a / d_t) * in_cut * taper  # Eq. 30
+        beta[[0, 1, -2, -1]] = 0.0
+        if n == 0 or not np.any(beta > 0):
+            results[k] = SmoothedCut(curve=cut.curve, t=t, before=Y0, after=Y0, beta=beta, max_displacement=0.0)
+            continue
+        bands = _filter_bands(s)
+        coef = _strength_scale(bands, beta) * beta[2:-2] / 6.0
+        work.append((k, t, Y0, beta, in_cut, coef, bands))
+    if not work:
+        return results
+    # --- the sweeps of every cut on one array: y_i += coef_i Σ_k band_ik y_{i-2+k} on the
+    # interior samples (Eq. 29 in arclength, the banded form of :func:`filter_matrix`)
+    Y0cat = np.concatenate([w[2] for w in work])
+    starts = np.cumsum([0] + [len(w[1]) for w in work])
+    weights = np.zeros((5, len(Y0cat) - 4, 1))
+    for (k, t, Y0, beta, in_cut, coef, bands), o in zip(work, starts):
+        for j in range(5):
+            weights[j, o : o + len(t) - 4, 0] = coef * bands[:, j]
+    Y = np.array(Y0cat)
+    done = 0
+    kept = [[] for _ in work]  # (checkpoint, Y) per cut
+    stop: list = [None] * len(work)
+    for c in _checkpoints(n):
+        w = weights
+        for _ in range(c - done):
+            Y[2:-2] += w[0] * Y[:-4] + w[1] * Y[1:-3] + w[2] * Y[2:-2] + w[3] * Y[3:-1] + w[4] * Y[4:]
         done = c
-        moved = float(np.max(np.linalg.norm(Y - Y0, axis=1)))
-        if bound is not None and moved > bound:
-            stop = (c, moved)
-            break
-        checkpoints.append(c)
-        Ys.append(Y)
-    offsets, curves_w = [], [Xw[None]]
-    if Ys:
-        Yk = np.stack(Ys, axis=1)  # (N, checkpoints, 3)
-        through = make_interp_spline(t, Yk, k=3)
-        disp = make_interp_spline(t, Yk - Y0[:, None], k=3)
-        offsets = [BlendedOffset(blade, cut.curve, BSpline(through.t, through.c[:, i], 3),
-                                 BSpline(disp.t, disp.c[:, i], 3), weight) for i in range(len(Ys))]
-        # BlendedOffset.on_exact for every checkpoint at once
-        d = np.moveaxis(disp(tw), 1, 0)  # (checkpoints, n, 3)
-        w = np.clip(weight(tw), 0.0, 1.0)
-        out = np.array(d)
-        on = w > 0.0
-        if np.any(on):
-            Son = np.moveaxis(through(tw[on]), 1, 0)
-            out[:, on] = d[:, on] + w[on, None] * (Son - Xw[on] - d[:, on])
-        curves_w.append(Xw + out)
-    excess = curve_excess_many(tw, np.concatenate(curves_w))
-    first = excess[0]
-    slack = GUARD_RELATIVE_SLACK * first + GUARD_RELATIVE_SLACK / d_e
-    best_e, best_n, best_Y, best_off = first, 0, Y0, None
-    last_e = first
-    for c, Yc, off, e in zip(checkpoints, Ys, offsets, excess[1:]):
-        last_e = e
-        if e <= best_e + slack:
-            best_e, best_n, best_Y, best_off = e, c, Yc, off
-    if stop is not None:
-        c, moved = stop
-        stop = (f"kept {best_n} of {n} sweeps: {c} sweeps would move the cut by {moved:.3g} m, "
-                f"beyond the deviation bound {bound:.3g} m")
-    elif best_n != n and last_e > best_e + slack:
-        stop = (f"kept {best_n} of {n} sweeps: more sweeps raise the cut's excess curvature variation "
-                f"({best_e:.4g} 1/m at {best_n} sweeps, {last_e:.4g} 1/m at {n}; unsmoothed {first:.4g} 1/m)")
-    if best_n == 0:
-        return SmoothedCut(curve=cut.curve, t=t, before=Y0, after=Y0, beta=beta, max_displacement=0.0,
-                           stopped=stop, irregularity=(first, first))
-    return SmoothedCut(
-        curve=replace(cut.curve, offset=best_off), t=t, before=Y0, after=best_Y, beta=beta,
-        max_displacement=float(np.max(np.linalg.norm(best_Y - Y0, axis=1))), iterations=best_n, stopped=stop,
-        irregularity=(first, best_e),
-    )
+        for i, o in enumerate(starts[:-1]):
+            if stop[i] is not None:
+                continue
+            Yc = Y[o : starts[i + 1]]
+            moved = float(np.max(np.linalg.norm(Yc - work[i][2], axis=1)))
+            if bound is not None and moved > bound:
+                stop[i] = (c, moved)
+                weights = weights.copy()
+                weights[:, o : starts[i + 1] - 4] = 0.0  # this cut stops here
+                continue
+            kept[i].append((c, Yc.copy()))
+    # --- the guard's measure: every cut's window, its checkpoints' curves, one batch
+    windows = measure_windows(blade, [cuts[w[0]] for w in work], d_e)
+    Xw_all = blade_points(blade, np.stack([cuts[w[0]].curve.parameters(tw) for w, tw in zip(work, windows)]))
+    splines, curves_w = [], []
+    for i, (k, t, Y0, beta, in_cut, coef, bands) in enumerate(work):
+        tw, Xw = windows[i], Xw_all[i]
+        m = len(kept[i])
+        curves_w.append(Xw[None])
+        if m:
+            Yk = np.stack([Yc for _, Yc in kept[i]], axis=1)  # (N, checkpoints, 3)
+            rhs = np.concatenate([in_cut[:, None], Yk.reshape(len(t), -1), (Yk - Y0[:, None]).reshape(len(t), -1)],
+                                 axis=1)
+        else:
+            rhs = in_cut[:, None]
+        # one interpolation for the weight, the checkpoints' curves and their displacements
+        # (LAPACK solves the columns independently: each is the spline of its own call)
+        S = make_interp_spline(t, rhs, k=3)
+        splines.append(S)
+        if m:
+            V = S(tw)
+            wv = np.clip(V[:, 0], 0.0, 1.0)
+            through = np.moveaxis(V[:, 1 : 1 + 3 * m].reshape(-1, m, 3), 1, 0)
+            d = np.moveaxis(V[:, 1 + 3 * m :].reshape(-1, m, 3), 1, 0)
+            # BlendedOffset.on_exact for every checkpoint at once
+            out = np.array(d)
+            on = wv > 0.0
+            if np.any(on):
+                out[:, on] = d[:, on] + wv[on, None] * (through[:, on] - Xw[on] - d[:, on])
+            curves_w.append(Xw + out)
+    excess_all = curve_excess_uniform(np.concatenate(curves_w))
+    sizes = np.cumsum([0] + [1 + len(kept_i) for kept_i in kept])  # the window curve + the checkpoints
+    for i, (k, t, Y0, beta, in_cut, coef, bands) in enumerate(work):
+        cut = cuts[k]
+        excess = excess_all[sizes[i] : sizes[i + 1]]
+        first = excess[0]
+        slack = GUARD_RELATIVE_SLACK * first + GUARD_RELATIVE_SLACK / d_e
+        best_e, best_n, best_Y, best_i = first, 0, Y0, None
+        last_e = first
+        for j, ((c, Yc), e) in enumerate(zip(kept[i], excess[1:])):
+            last_e = e
+            if e <= best_e + slack:
+                best_e, best_n, best_Y, best_i = e, c, Yc, j
+        why = None
+        if stop[i] is not None:
+            c, moved = stop[i]
+            why = (f"kept {best_n} of {n} sweeps: {c} sweeps would move the cut by {moved:.3g} m, "
+                   f"beyond the deviation bound {bound:.3g} m")
+        elif best_n != n and last_e > best_e + slack:
+            why = (f"kept {best_n} of {n} sweeps: more sweeps raise the cut's excess curvature variation "
+                   f"({best_e:.4g} 1/m at {best_n} sweeps, {last_e:.4g} 1/m at {n}; unsmoothed {first:.4g} 1/m)")
+        if best_n == 0:
+            results[k] = SmoothedCut(curve=cut.curve, t=t, before=Y0, after=Y0, beta=beta, max_displacement=0.0,
+                                     stopped=why, irregularity=(first, first))
+            continue
+        S, m = splines[i], len(kept[i])
+        C = S.c
+        weight = BSpline.construct_fast(S.t, np.ascontiguousarray(C[:, 0]), 3)
+        through = BSpline(S.t, C[:, 1 : 1 + 3 * m].reshape(-1, m, 3)[:, best_i], 3)
+        disp = BSpline(S.t, C[:, 1 + 3 * m :].reshape(-1, m, 3)[:, best_i], 3)
+        off = BlendedOffset(blade, cut.curve, through, disp, weight)
+        results[k] = SmoothedCut(
+            curve=replace(cut.curve, offset=off), t=t, before=Y0, after=best_Y, beta=beta,
+            max_displacement=float(np.max(np.linalg.norm(best_Y - Y0, axis=1))), iterations=best_n, stopped=why,
+            irregularity=(first, best_e),
+        )
+    return results
 
 
 # ---------------------------------------------------------------------------------------

@@ -67,6 +67,8 @@ MARCH_MAX_TURN = 0.12
 #: Cells of the cached surrogate of b used for marching (ξ and w = sqrt(1 - η)).
 CACHE_XI_CELLS = 256
 CACHE_W_CELLS = 48
+#: Extra cell rows built beyond the farthest one reached (:class:`BladeCache`).
+CACHE_ROW_MARGIN = 2
 #: The ξ-search of Eq. 21 must stay this close (in ξ) to the predictor.
 XI_SEARCH_MAX_SHIFT = 0.25
 #: A half-cut that reaches the edge line ξ = ξ_1 farther than this fraction of its
@@ -124,27 +126,6 @@ def cut_parameters(a: np.ndarray, m: int) -> np.ndarray:
     return t
 
 
-def _powers(s: np.ndarray) -> np.ndarray:
-    """(1, s, s², s³) as columns (n, 4) (filled in place: np.stack costs more than the
-    arithmetic at the march's sizes)."""
-    out = np.empty((s.size, 4))
-    out[:, 0] = 1.0
-    out[:, 1] = s
-    out[:, 2] = s * s
-    out[:, 3] = out[:, 2] * s
-    return out
-
-
-def _power_derivatives(s: np.ndarray) -> np.ndarray:
-    """(0, 1, 2s, 3s²) as columns (n, 4)."""
-    out = np.empty((s.size, 4))
-    out[:, 0] = 0.0
-    out[:, 1] = 1.0
-    out[:, 2] = 2 * s
-    out[:, 3] = 3 * s * s
-    return out
-
-
 def _fail(label, p, what):
     return GeometryError(
         f"blade cut {label}: {what} at ξ = {p[0]:.6g}, η = {p[1]:.6g} "
@@ -170,11 +151,24 @@ class BladeCache:
         self.w_max = float(np.sqrt(1.0 - blade.eta_min))
         self.hx = 1.0 / n_xi
         self.hw = self.w_max / n_w
-        xg = np.arange(n_xi + 1) * self.hx
+        self._xg = np.arange(n_xi + 1) * self.hx
         wg = np.arange(n_w + 1) * self.hw
-        wg_eval = np.maximum(wg, np.sqrt(ETA_TIP_GUARD))
-        eta = np.clip(1.0 - wg_eval**2, blade.eta_min, 1.0 - ETA_TIP_GUARD)
-        D = blade.mixed_derivatives(xg[:-1, None], eta[None, :])  # (n_xi, n_w+1, 3, 3, 3)
+        self._wg_eval = np.maximum(wg, np.sqrt(ETA_TIP_GUARD))
+        self._eta = np.clip(1.0 - self._wg_eval**2, blade.eta_min, 1.0 - ETA_TIP_GUARD)
+        self.coef = np.empty((n_xi, n_w, 4, 4, 3))
+        #: cell rows (in w, from the tip) whose coefficients are filled: the cuts near the
+        #: tip visit about half of them, so rows are built when first reached
+        self.rows = 0
+
+    def _build_rows(self, rows: int) -> None:
+        """Fill the coefficients of the cell rows self.rows .. rows - 1 (each cell from
+        the exact b and its derivatives at its corners, as if the whole grid were built)."""
+        rows = min(int(rows), self.n_w)
+        a = self.rows
+        if rows <= a:
+            return
+        xg, wg_eval, eta = self._xg, self._wg_eval[a : rows + 1], self._eta[a : rows + 1]
+        D = self.blade.mixed_derivatives(xg[:-1, None], eta[None, :])  # (n_xi, rows-a+1, 3, 3, 3)
         D = np.concatenate([D, D[:1]], axis=0)
         dw = -2.0 * wg_eval[None, :, None]  # dη/dw
         F = D[..., 0, 0, :]
@@ -192,22 +186,36 @@ class BladeCache:
         G[2, 0], G[3, 0], G[2, 1], G[3, 1] = fx[0], fx[1], fx[2], fx[3]
         G[0, 2], G[1, 2], G[0, 3], G[1, 3] = fw[0], fw[1], fw[2], fw[3]
         G[2, 2], G[3, 2], G[2, 3], G[3, 3] = fxw[0], fxw[1], fxw[2], fxw[3]
-        C = np.einsum("ai,ijxyk,bj->xyabk", self._H, G, self._H)
-        self.coef = np.ascontiguousarray(C)  # (n_xi, n_w, 4, 4, 3)
+        self.coef[:, a:rows] = np.einsum("ai,ijxyk,bj->xyabk", self._H, G, self._H)
+        self.rows = rows
 
     def derivatives(self, p, order: int = 1) -> np.ndarray:
         """b, b_ξ, b_η of the surrogate at p (n, 2), in the layout of
         ``BladeSurface.derivatives(order=1)``: (n, 2, 2, 3)."""
         xi = np.mod(p[:, 0], 1.0)
-        w = np.sqrt(np.clip(1.0 - p[:, 1], ETA_TIP_GUARD, None))
+        w = np.sqrt(np.maximum(1.0 - p[:, 1], ETA_TIP_GUARD))
         x = xi / self.hx
         i = np.minimum(x.astype(np.intp), self.n_xi - 1)
-        s = x - i
         y = np.minimum(w, self.w_max) / self.hw
         j = np.minimum(y.astype(np.intp), self.n_w - 1)
-        r = y - j
+        if j.size and j.max() >= self.rows:
+            self._build_rows(j.max() + 1 + CACHE_ROW_MARGIN)
         C = self.coef[i, j]
-        S, dS, Rr, dR = _powers(s), _power_derivatives(s), _powers(r), _power_derivatives(r)
+        # the power bases (1, s, s², s³) and (0, 1, 2s, 3s²) for s (ξ) and r (w), both at once
+        sr = np.empty((2, len(p)))
+        np.subtract(x, i, out=sr[0])
+        np.subtract(y, j, out=sr[1])
+        P = np.empty((2, len(p), 4))
+        P[..., 0] = 1.0
+        P[..., 1] = sr
+        P[..., 2] = sr * sr
+        P[..., 3] = P[..., 2] * sr
+        Pd = np.empty((2, len(p), 4))
+        Pd[..., 0] = 0.0
+        Pd[..., 1] = 1.0
+        Pd[..., 2] = 2 * sr
+        Pd[..., 3] = 3 * sr * sr
+        S, dS, Rr, dR = P[0], Pd[0], P[1], Pd[1]
         out = np.zeros((len(p), order + 1, order + 1, 3))
         CR = np.einsum("nabk,nb->nak", C, Rr)
         out[:, 0, 0] = np.einsum("na,nak->nk", S, CR)
@@ -242,19 +250,23 @@ def chart_derivatives(deriv, eta_min):
         c = np.array(c, dtype=np.float64)
         r2 = np.sum(c * c, axis=1)
         big = r2 > r_max2
-        c[big] *= np.sqrt(r_max2 / r2[big])[:, None]
-        r2 = np.clip(np.minimum(r2, r_max2), ETA_TIP_GUARD, None)
-        p = from_tip_chart(c)
+        if big.any():
+            c[big] *= np.sqrt(r_max2 / r2[big])[:, None]
+        r2 = np.maximum(np.minimum(r2, r_max2), ETA_TIP_GUARD)
+        # from_tip_chart(c) (ξ_ref = 0), written out: the same operations, fewer calls
+        p = np.empty_like(c)
+        p[:, 0] = np.mod(np.arctan2(c[:, 1], c[:, 0]) / (2.0 * np.pi) + 0.5, 1.0) - 0.5
+        p[:, 1] = 1.0 - (c[:, 0] ** 2 + c[:, 1] ** 2)
         D = deriv(p, 1)
         X, Y = c[:, 0:1], c[:, 1:2]
         bxi, beta = D[:, 1, 0], D[:, 0, 1]
         k = 1.0 / (2.0 * np.pi * r2[:, None])
-        out = np.empty_like(D)
-        out[:, 0, 0] = D[:, 0, 0]
-        out[:, 1, 0] = -Y * k * bxi - 2.0 * X * beta
-        out[:, 0, 1] = X * k * bxi - 2.0 * Y * beta
-        out[:, 1, 1] = 0.0
-        return out
+        b_X = -Y * k * bxi - 2.0 * X * beta
+        b_Y = X * k * bxi - 2.0 * Y * beta
+        D[:, 1, 0] = b_X
+        D[:, 0, 1] = b_Y
+        D[:, 1, 1] = 0.0
+        return D
 
     return evaluate
 
@@ -270,6 +282,9 @@ class _PlaneSolver:
         self.eta_min = eta_min
         self.r_max2 = 1.0 - eta_min
         self.tol = PLANE_TOL * radius
+        #: (b_X·n̂, b_Y·n̂) at the points of the last :meth:`solve` where known (NaN elsewhere)
+        self.gradient = None
+        self.last_gradient = None
 
     def residual(self, p, idx, order=1):
         """f = (b(p) - x_0)·n̂ (Eq. 16), its chart gradient (b_X·n̂, b_Y·n̂), and the
@@ -287,6 +302,7 @@ class _PlaneSolver:
         s = np.zeros(len(idx))
         ok = np.zeros(len(idx), dtype=bool)
         p = trial.copy()
+        grad = np.full((len(idx), 2), np.nan)  # (b_X·n̂, b_Y·n̂) where converged
         todo = np.arange(len(idx))
         for _ in range(NEWTON_MAX_ITERATIONS):
             if todo.size == 0:
@@ -296,6 +312,7 @@ class _PlaneSolver:
             p[todo] = pt
             conv = np.abs(f) < self.tol
             ok[todo[conv]] = True
+            grad[todo[conv]] = g[conv]
             todo, f, g = todo[~conv], f[~conv], g[~conv]
             fp = np.einsum("ij,ij->i", g, m[todo])
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -304,6 +321,7 @@ class _PlaneSolver:
             s[todo] += np.where(bad, 0.0, ds)
             todo = todo[~bad]
         ok &= np.sum(p * p, axis=1) <= self.r_max2
+        self.last_gradient = grad
         return p, ok
 
     def xi_search(self, trial, idx):
@@ -325,6 +343,7 @@ class _PlaneSolver:
             with np.errstate(divide="ignore", invalid="ignore"):
                 dxi = np.where(ok, 0.0, -f / fp)
             xi += np.clip(np.where(np.isfinite(dxi), dxi, 0.0), -0.05, 0.05)
+        self.last_gradient = g  # at the p returned (the last evaluation)
         return p, ok & (np.abs(xi - xi0) < XI_SEARCH_MAX_SHIFT)
 
     def bisection(self, trial, m, idx):
@@ -355,12 +374,21 @@ class _PlaneSolver:
         return p, ok
 
     def solve(self, trial, m, idx, labels, counts, per_item=None):
-        """Newton (Eq. 20), then the ξ-search (Eq. 21), then bisection (Eq. 22)."""
+        """Newton (Eq. 20), then the ξ-search (Eq. 21), then bisection (Eq. 22).
+        ``self.gradient``: (b_X·n̂, b_Y·n̂) at the returned points where the search that
+        found them evaluated it there (NaN elsewhere)."""
+        self.last_gradient = None
         p, ok = self.newton_line(trial, m, idx)
+        grad = self.last_gradient
+        self.gradient = grad = np.full((len(idx), 2), np.nan) if grad is None else grad
         if np.all(ok):
             return p
+        grad[~ok] = np.nan
         bad = np.flatnonzero(~ok)
+        self.last_gradient = None
         pb, okb = self.xi_search(trial[bad], idx[bad])
+        if self.last_gradient is not None:
+            grad[bad[okb]] = self.last_gradient[okb]
         p[bad[okb]] = pb[okb]
         counts["xi_search"] += int(okb.sum())
         if per_item is not None:
@@ -451,7 +479,11 @@ def _march(solver, blade, start, end, labels, counts):
         active = idx[~passed]
         if active.size == 0:
             break
-        f, g, D = solver.residual(cur[active], active)
+        # the gradient at the new points: the corrector evaluated it there already
+        g = solver.gradient[~passed]
+        redo = np.flatnonzero(np.isnan(g[:, 0]))
+        if redo.size:
+            g[redo] = solver.residual(cur[active[redo]], active[redo])[1]
     else:
         h = int(active[0])
         raise _fail(labels[h], cur[h], f"no arrival at the edge point after {MARCH_MAX_STEPS} steps")

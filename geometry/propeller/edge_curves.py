@@ -39,7 +39,7 @@ from scipy.interpolate import make_interp_spline
 
 from ..errors import DefinitionError, GeometryError
 from .corners import Corners, HubCurve, ParameterCurve, SplineCurve, blade_points, hub_edge_curves, top_edge_curves
-from .cut_smoothing import GUARD_BOUND_FRACTION, SMOOTHING_ZONE_BOUND, smooth_cut
+from .cut_smoothing import GUARD_BOUND_FRACTION, SMOOTHING_ZONE_BOUND, smooth_cuts
 from .cuts import blade_cache, march_cuts
 
 #: Samples of each edge (in w = sqrt(1 - η)) for the arclength of c_LETE.
@@ -311,12 +311,16 @@ def build_edge_curves(blade, corners: Corners, sides: dict, settings, progress=N
               spacing=settings.sample_spacing * R, edge_spacing=settings.sample_spacing * settings.edge_spacing_ratio * R,
               bound=GUARD_BOUND_FRACTION * SMOOTHING_ZONE_BOUND * R)
     smoothing = {}
+    # every cut within d_t of the tip, smoothed in one batch (cut_smoothing.smooth_cuts)
+    todo = [(c, abs(s - s_tip) * L, ("tip", i)) for i, (c, s) in enumerate(zip(tip_cuts, s_cut))]
+    todo += [(c, abs(s_le_c[i] - s_tip) * L, ("leading", i)) for c, i in zip(le_cuts, ie)]
+    todo += [(c, abs(s_te_c[i] - s_tip) * L, ("trailing", i)) for c, i in zip(te_cuts, ie)]
+    todo = [x for x in todo if x[1] < d_t]
+    smoothing.update(zip([x[2] for x in todo], smooth_cuts(blade, [x[0] for x in todo], [x[1] for x in todo], **kw)))
 
     def finish(cut, s_edge, key):
-        a = abs(s_edge - s_tip) * L
-        if a < d_t:
-            sm = smooth_cut(blade, cut, a, **kw)
-            smoothing[key] = sm
+        sm = smoothing.get(key)
+        if sm is not None:
             return sm.curve, True
         return cut.curve, False
 

@@ -33,6 +33,8 @@ from .corners import blade_points
 WINDOW_SAMPLES = 1201
 #: Parameters at which the plain cut is scanned for its window.
 WINDOW_SCAN = 2001
+#: Every this many scan parameters are evaluated first (:func:`measure_windows`).
+WINDOW_COARSE = 10
 
 
 def excess_curvature_variation(kappa) -> float:
@@ -124,3 +126,111 @@ def tip_irregularity(blade, curves, d_e: float) -> dict:
     after = float(sum(p["smoothed"] for p in per))
     return {"unsmoothed": before, "smoothed": after, "ratio": after / before if before > 0 else 1.0,
             "curves": len(per), "per_curve": per}
+
+
+def measure_windows(blade, cuts, d_e: float) -> list[np.ndarray]:
+    """:func:`measure_window` of several cuts with one evaluation of b.
+
+    The window only needs the first and last of the WINDOW_SCAN parameters within d_e of
+    x_1. Scanned every WINDOW_COARSE-th parameter first; where the coarse distances fall
+    monotonically to their minimum and rise after it (a cut that runs round its edge
+    once), only the parameters next to the two coarse crossings are evaluated, which gives
+    the same first and last parameters; otherwise the whole scan (as before)."""
+    t = np.linspace(0.0, 1.0, WINDOW_SCAN)
+    coarse = t[::WINDOW_COARSE]
+    x1 = np.stack([c.points[1] for c in cuts])
+    P = np.stack([c.curve.parameters(coarse) for c in cuts])
+    dist = np.linalg.norm(blade_points(blade, P) - x1[:, None], axis=2)
+    out = [None] * len(cuts)
+    fine_t, fine_k, full = [], [], []
+    for k, d in enumerate(dist):
+        m = int(np.argmin(d))
+        inside = np.flatnonzero(d < d_e)
+        fall, rise = np.diff(d[: m + 1]), np.diff(d[m:])
+        if inside.size == 0 or not (np.all(fall < 0) and np.all(rise > 0)):
+            full.append(k)
+            continue
+        # the fine parameters between the coarse samples around each crossing
+        a, b = inside[0], inside[-1]
+        lo = np.arange(max(a - 1, 0) * WINDOW_COARSE, a * WINDOW_COARSE + 1)
+        hi = np.arange(b * WINDOW_COARSE, min((b + 1) * WINDOW_COARSE, t.size - 1) + 1)
+        fine_t.append(np.concatenate([lo, hi]))
+        fine_k.append(k)
+    if fine_k:
+        idx = fine_t
+        pts = [cuts[k].curve.parameters(t[i]) for k, i in zip(fine_k, idx)]
+        X = blade_points(blade, np.concatenate(pts))
+        off = 0
+        for k, i in zip(fine_k, idx):
+            d = np.linalg.norm(X[off : off + i.size] - x1[k], axis=1)
+            off += i.size
+            inside = i[d < d_e]
+            lo, hi = t[max(inside[0] - 1, 0)], t[min(inside[-1] + 1, t.size - 1)]
+            out[k] = np.linspace(lo, hi, WINDOW_SAMPLES)
+    for k in full:
+        out[k] = measure_window(blade, cuts[k], d_e)
+    return out
+
+
+def _spline_node_derivatives(Y: np.ndarray):
+    """First and second derivatives at the nodes of the not-a-knot cubic interpolating
+    spline (the spline of ``make_interp_spline(t, Y, k=3)``) through Y (n, ...) at evenly
+    spaced parameters, unit spacing: M (second derivatives) from the tridiagonal
+    equations M_{i-1} + 4M_i + M_{i+1} = 6 δ²y_i and the not-a-knot ends
+    M_0 - 2M_1 + M_2 = 0, M_{n-3} - 2M_{n-2} + M_{n-1} = 0 (one banded solve for all
+    columns)."""
+    from scipy.linalg import solve_banded
+
+    shape = Y.shape
+    n = shape[0]
+    Y = Y.reshape(n, -1)
+    ab = np.zeros((5, n))
+    # ab[2 + i - j, j] = A[i, j]
+    ab[2, 1:-1] = 4.0
+    ab[1, 2:] = 1.0  # A[i, i+1], i = 1..n-2
+    ab[3, :-2] = 1.0  # A[i, i-1], i = 1..n-2
+    ab[2, 0], ab[1, 1], ab[0, 2] = 1.0, -2.0, 1.0  # row 0
+    ab[4, n - 3], ab[3, n - 2], ab[2, n - 1] = 1.0, -2.0, 1.0  # row n-1
+    rhs = np.empty_like(Y)
+    rhs[0] = rhs[-1] = 0.0
+    np.subtract(Y[:-2], 2.0 * Y[1:-1], out=rhs[1:-1])
+    rhs[1:-1] += Y[2:]
+    rhs[1:-1] *= 6.0
+    M = solve_banded((2, 2), ab, rhs, overwrite_ab=True, overwrite_b=True, check_finite=False)
+    d1 = np.empty_like(Y)
+    np.subtract(Y[1:], Y[:-1], out=d1[:-1])
+    d1[:-1] -= (2.0 * M[:-1] + M[1:]) / 6.0
+    d1[-1] = (Y[-1] - Y[-2]) + (M[-2] + 2.0 * M[-1]) / 6.0
+    return d1.reshape(shape), M.reshape(shape)
+
+
+def curve_excess_uniform(X) -> np.ndarray:
+    """:func:`curve_excess` of curves sampled at the same evenly spaced parameters, X
+    (m, n, 3) -> (m,): the same measure (the curvature of the cubic interpolating spline
+    at the samples; it does not depend on the parameter scale), computed for all curves
+    at once from the spline's node derivatives (equal to :func:`curve_excess_many` to
+    round-off)."""
+    X = np.asarray(X, dtype=np.float64)
+    m, n, _ = X.shape
+    d1, d2 = _spline_node_derivatives(np.ascontiguousarray(np.moveaxis(X, 0, 1)))  # (n, m, 3)
+    ax, ay, az = d1[..., 0], d1[..., 1], d1[..., 2]
+    bx, by, bz = d2[..., 0], d2[..., 1], d2[..., 2]
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx  # c' x c'', (n, m)
+    nx, ny, nz = cx.sum(axis=0), cy.sum(axis=0), cz.sum(axis=0)
+    nn = np.sqrt(nx * nx + ny * ny + nz * nz)
+    out = np.zeros(m)
+    ok = nn > 0.0
+    inv = 1.0 / np.where(ok, nn, 1.0)
+    speed2 = ax * ax + ay * ay + az * az
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = (cx * (nx * inv) + cy * (ny * inv) + cz * (nz * inv)) / (speed2 * np.sqrt(speed2))  # (n, m)
+    finite = np.all(np.isfinite(k), axis=0)
+    use = ok & finite
+    kk = k[:, use]
+    if kk.size:
+        tv = np.sum(np.abs(np.diff(kk, axis=0)), axis=0)
+        pk = kk[np.argmax(np.abs(kk), axis=0), np.arange(kk.shape[1])]
+        out[use] = np.maximum(0.0, tv - np.abs(pk - kk[0]) - np.abs(pk - kk[-1]))
+    for i in np.flatnonzero(ok & ~finite):
+        out[i] = excess_curvature_variation(k[:, i])
+    return out

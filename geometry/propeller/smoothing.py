@@ -566,7 +566,12 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
             report["warnings"].append(
                 f"inside the smoothing zone the surfaces depart from the blade by up to {dev['max_inside']:.3g} m "
                 f"({dev['max_inside'] / D:.3g} D), more than the bound {SMOOTHING_ZONE_BOUND * R:.3g} m")
-        report["shared_edges"] = [{k: v for k, v in e.items() if k != "angles"} for e in shared_edge_report(surfaces)]
+        # SHARED_EDGES names the surfaces by their place (pressure_central at ξ < 1/2, the
+        # pressure side of a right-handed blade); a left-handed blade's are swapped above
+        layout = dict(surfaces)
+        if blade.hand < 0:
+            layout["pressure_central"], layout["suction_central"] = surfaces["suction_central"], surfaces["pressure_central"]
+        report["shared_edges"] = [{k: v for k, v in e.items() if k != "angles"} for e in shared_edge_report(layout)]
         lap("measure")
     report["times_s"]["total"] = sum(v for k, v in times.items() if k != "total")
     return SmoothedBlade(**surfaces, parameter_surfaces=params, curves=curves, overlays=overlays, report=report,
@@ -574,11 +579,14 @@ def smooth_blade(model, settings: SmoothingSettings | None = None, progress=None
 
 
 def _check_orientation(blade, pairs: dict) -> None:
-    """S_u × S_v must point out of the blade on all five surfaces (Hally Eq. 1)."""
-    for name, pair in pairs.items():
-        u = np.array([0.3, 0.5, 0.7])
-        S, P = pair.surface, pair.parameters
-        n_s = S.normal(u, u)
-        n_b = blade.normal(P.evaluate(u, u)[:, 0], np.clip(P.evaluate(u, u)[:, 1], blade.eta_min, 1 - 1e-9))
-        if np.any(np.einsum("ij,ij->i", n_s, n_b) <= 0):
+    """S_u × S_v must point out of the blade on all five surfaces (Hally Eq. 1): three
+    points each, the blade's normals at all of them in one evaluation."""
+    u = np.array([0.3, 0.5, 0.7])
+    names = list(pairs)
+    n_s = np.concatenate([pairs[k].surface.normal(u, u) for k in names])
+    P = np.concatenate([pairs[k].parameters.evaluate(u, u) for k in names])
+    n_b = blade.normal(P[:, 0], np.clip(P[:, 1], blade.eta_min, 1 - 1e-9))
+    bad = np.einsum("ij,ij->i", n_s, n_b).reshape(len(names), u.size) <= 0
+    for name, row in zip(names, bad):
+        if np.any(row):
             raise GeometryError(f"the {name} surface is not oriented outwards (internal error)")
