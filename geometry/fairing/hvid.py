@@ -56,6 +56,7 @@ from ..files import atomic_write
 from ..errors import DefinitionError, GeometryError
 from ..nurbs import BSplineCurve, closest_point_curve, split
 from ..nurbs.basis import basis_function_derivatives, basis_functions, find_span
+from ..nurbs.local_projection import closest_points_near
 from .curvature import arclength_table, curvature_at, derivatives, params_at_arclength, span_samples
 from .distributions import DistributionReport, PolynomialDistribution, curvature_fractions, distribution_report
 
@@ -776,18 +777,32 @@ def _dense_extremes(curve: BSplineCurve, sign: float) -> tuple[float, float]:
     return float(k.min()), float(k.max())
 
 
-def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndarray, data: np.ndarray, measure: bool = True) -> Deviation:
+def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndarray, data: np.ndarray, measure: bool = True,
+               data_params: np.ndarray | None = None) -> Deviation:
+    """The deviation report. The true distances are closest points (NURBS Book §6.1)
+    found from the parameter correspondence (:func:`.nurbs.local_projection.closest_point_curve_near`):
+    the smoothed and the unsmoothed curve share their knots and lie close, so each sample's
+    own parameter starts its foot's search on the other curve; the data points start at
+    ``data_params`` (their parameters on the smoothed curve, approximately) or, when not
+    given, at the nearest sample. The closest points are certified global there, and
+    found by the general search where they cannot be."""
     same = float(np.max(np.linalg.norm(smoothed.evaluate(params) - unsmoothed.evaluate(params), axis=1)))
     if not measure:
         return Deviation(same, float("nan"), float("nan"))
     us = span_samples(smoothed, DEVIATION_SAMPLES_PER_SPAN)
-    # the curves are close, each knot span short and gently curved: 4 bracket samples per
-    # span (the projection refines them where the curve turns) find every foot
-    k = DEVIATION_BRACKET_SAMPLES
-    _, d1 = closest_point_curve(unsmoothed, smoothed.evaluate(us), samples_per_span=k)
-    _, d2 = closest_point_curve(smoothed, unsmoothed.evaluate(span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)),
-                                samples_per_span=k)
-    _, d3 = closest_point_curve(smoothed, data, samples_per_span=k)
+    ss = us if np.array_equal(smoothed.knots, unsmoothed.knots) else span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)
+    on_smoothed = smoothed.evaluate(us)
+    if data_params is None:
+        from scipy.spatial import cKDTree
+
+        data_params = us[cKDTree(on_smoothed).query(data)[1]]
+    # one pass: the smoothed samples onto the unsmoothed curve (0), the unsmoothed samples
+    # and the data onto the smoothed one (1)
+    n1, n2 = us.size, ss.size
+    _, d = closest_points_near([unsmoothed, smoothed], np.concatenate([on_smoothed, unsmoothed.evaluate(ss), data]),
+                               np.concatenate([us, ss, np.asarray(data_params, dtype=np.float64)]),
+                               np.repeat([0, 1, 1], [n1, n2, len(data)]))
+    d1, d2, d3 = d[:n1], d[n1: n1 + n2], d[n1 + n2:]
     t, s = arclength_table(smoothed, DEVIATION_SAMPLES_PER_SPAN)
     return Deviation(same, float(max(d1.max(), d2.max())), float(d3.max()), (s / s[-1], d1))
 
@@ -828,7 +843,7 @@ def _run(
     if converged and rescale_chord is not None:
         curve, chord_scale = rescale_chord(curve, unsmoothed)
     kappa1 = op.curvature(curve.control_points)
-    return unsmoothed, params, curve, kappa0, target, kappa1, history, converged, reason, report, chord_scale
+    return unsmoothed, params, curve, kappa0, target, kappa1, history, converged, reason, report, chord_scale, u_src
 
 
 def _keep_turning(target: np.ndarray, kappa: np.ndarray, curve: BSplineCurve, params: np.ndarray) -> np.ndarray:
@@ -980,7 +995,7 @@ def smooth2d(
     # closed: one more fraction, the last (= 1) repeating the first point of the loop
     fractions = curvature_fractions(source, settings.smoothing_points + int(closed), alpha)
     output_fractions = curvature_fractions(source, settings.output_points, alpha)
-    (unsmoothed, params, curve, k0, target, k1, history, converged, reason, report, _) = _run(
+    (unsmoothed, params, curve, k0, target, k1, history, converged, reason, report, _, _) = _run(
         source, fractions, output_fractions, settings, progress, closed=closed
     )
     if not converged and raise_on_failure:
@@ -1170,7 +1185,7 @@ def smoothfoil(
     # area sign: the outline runs clockwise (< 0) or anticlockwise; convex is positive
     x, y = work[:, 0], work[:, 1]
     sign = 1.0 if np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0 else -1.0
-    source, _ = spline_through(work, settings.end_derivative_order)
+    source, work_params = spline_through(work, settings.end_derivative_order)
     apex = work[0].copy()
 
     def rescale_chord(curve: BSplineCurve, unsmoothed: BSplineCurve) -> tuple[BSplineCurve, float]:
@@ -1189,7 +1204,7 @@ def smoothfoil(
 
     fractions = distribution.fractions(settings.smoothing_points)
     output_fractions = distribution.fractions(settings.output_points)
-    (unsmoothed, params, curve, k0_, target, k1_, history, converged, reason, report, factor) = _run(
+    (unsmoothed, params, curve, k0_, target, k1_, history, converged, reason, report, factor, u_src) = _run(
         source, fractions, output_fractions, settings, progress, rescale_chord if rescale else None
     )
     if not converged and raise_on_failure:
@@ -1204,7 +1219,8 @@ def smoothfoil(
         cut = split(split(curve, float(ua))[1], float(ub))[0]
         inside = (u_out > ua) & (u_out < ub)
         out_points = np.concatenate([cut.evaluate(cut.domain[0])[None], out_points[inside], cut.evaluate(cut.domain[1])[None]])
-    deviation = _deviation(curve, unsmoothed, params, work, measure)
+    # the data's parameters on the smoothed curve, about: source -> knot parameters (same knots as curve)
+    deviation = _deviation(curve, unsmoothed, params, work, measure, np.interp(work_params, u_src, params))
     # back to the input frame: x ↦ le + chord · Rᵀ (le2 + chord2 R2ᵀ x)
     Rt, R2t = R.T, R2.T
 

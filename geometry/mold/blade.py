@@ -30,6 +30,7 @@ import numpy as np
 from ..errors import BladesmithError, GeometryError
 from ..nurbs import BSplineCurve, BSplineSurface, interpolate, skin
 from ..nurbs.fitting import approximation_knots, parameterize
+from ..nurbs.local_projection import closest_points_near
 from ..nurbs.projection import closest_point_curve
 from ..nurbs.skinning import skin_parameters
 from .definition import BladeDefinition
@@ -192,11 +193,32 @@ def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None
     return [fit(k, ratio=rho) for k in range(len(splits))], rho
 
 
+def data_parameters(split: SplitSection, fit: TwoPartFit) -> tuple[np.ndarray, np.ndarray]:
+    """The parameters the fit gave the section's data points (upper_data, lower_data
+    order) on its two halves: where their closest points are sought first."""
+    pu, pl = fit.params_upper, fit.params_lower
+    if pu is None or pl is None:
+        pu, pl = parameterize(split.upper), parameterize(split.lower)
+    if split.upper_marks is None:
+        return pu[:-1], pl[1:]  # S (interpolated) is the last row of upper, the first of lower
+    return pu[split.upper_marks], pl[split.lower_marks]
+
+
+def _closest_distances(pairs) -> list[np.ndarray]:
+    """Closest-point distances of each (curve, points, guess) of ``pairs``, all in one
+    pass (:func:`..nurbs.local_projection.closest_points_near`, certified global)."""
+    counts = [len(P) for _, P, _ in pairs]
+    _, d = closest_points_near([c for c, _, _ in pairs], np.concatenate([P for _, P, _ in pairs]),
+                               np.concatenate([g for _, _, g in pairs]), np.repeat(np.arange(len(pairs)), counts))
+    return np.split(d, np.cumsum(counts)[:-1])
+
+
 def section_deviation(split: SplitSection, fit: TwoPartFit) -> float:
     """Largest closest-point distance of the section's data to its two fitted halves,
     as a fraction of the chord."""
-    du = closest_point_curve(fit.upper, split.points[split.upper_data])[1]
-    dl = closest_point_curve(fit.lower, split.points[split.lower_data])[1]
+    gu, gl = data_parameters(split, fit)
+    du, dl = _closest_distances([(fit.upper, split.points[split.upper_data], gu),
+                                 (fit.lower, split.points[split.lower_data], gl)])
     return float(max(du.max(), dl.max()) / split.chord)
 
 
@@ -723,7 +745,7 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
 
     # tolerance by closest-point distance to the skinned surfaces' sections
     t0 = time.perf_counter()
-    reports = []
+    reports, pairs = [], []
     for k, (sp, f) in enumerate(zip(splits, fits)):
         rep = StationReport(k, defn.stations[k].r, sp.chord, f.lsq_error,
                             single_fits[k].lsq_error if k in single_fits else float("nan"),
@@ -733,10 +755,12 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
             cu, cl = upper.iso_curve("v", v[j]), lower.iso_curve("v", v[j])
         else:
             cu, cl = tr_u.iso_curve("v", w[k]), tr_l.iso_curve("v", w[k])
-        du = closest_point_curve(cu, sp.points[sp.upper_data])[1]
-        dl = closest_point_curve(cl, sp.points[sp.lower_data])[1]
-        rep.deviation_two_part = float(max(du.max(), dl.max()) / sp.chord)
+        gu, gl = data_parameters(sp, f)  # the iso-curves have the fits' knots
+        pairs += [(cu, sp.points[sp.upper_data], gu), (cl, sp.points[sp.lower_data], gl)]
         reports.append(rep)
+    dist = _closest_distances(pairs)  # every station's closest points in one pass
+    for k, (rep, sp) in enumerate(zip(reports, splits)):
+        rep.deviation_two_part = float(max(dist[2 * k].max(), dist[2 * k + 1].max()) / sp.chord)
     times["tolerance_check"] = time.perf_counter() - t0
     tick(0.85)
 

@@ -346,6 +346,10 @@ class TwoPartFit:
     lsq_error: float
     max_residual: float
     slsqp_iterations: int
+    #: The halves' data parameters (every row of the split's halves, S included): where
+    #: the closest-point measurements start (:func:`~.blade.data_parameters`).
+    params_upper: np.ndarray | None = None
+    params_lower: np.ndarray | None = None
 
 
 def default_knots(points, n_control: int, degree: int = SECTION_DEGREE) -> np.ndarray:
@@ -428,7 +432,7 @@ def _finish(up: _AffineHalf, lo: _AffineHalf, split: SplitSection, lam_u: float,
     rl = rl[1:] if split.lower_marks is None else rl[split.lower_marks]
     err = float(np.sum(ru**2) + np.sum(rl**2))
     mx = float(max(np.linalg.norm(ru, axis=1).max(), np.linalg.norm(rl, axis=1).max()))
-    return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, iterations)
+    return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, iterations, up.params, lo.params)
 
 
 @dataclass(frozen=True, eq=False)
