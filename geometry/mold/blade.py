@@ -173,9 +173,11 @@ def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None
         return {"params_upper": aligned_parameters(splits[k].upper, Ku, degree),
                 "params_lower": aligned_parameters(splits[k].lower, Kl, degree)}
 
+    halves = {}  # per station: the halves' solutions, shared by its free and constrained fits
+
     def fit(k, **kw):
         try:
-            return fit_two_part(splits[k], Ku, Kl, degree=degree, **params(k), **kw)
+            return fit_two_part(splits[k], Ku, Kl, degree=degree, **params(k), **kw, cache=halves.setdefault(k, {}))
         except BladesmithError as exc:
             st = defn.stations[k]
             raise StationFitError(f"station {k} (r = {st.r:g} m, airfoil {st.airfoil_name or st.airfoil.name!r}): "
@@ -248,12 +250,15 @@ def root_transition(root_nets, aero: BSplineSurface, w, scale: float, degree_w: 
     q = min(degree_w, K)
     V, P = aero.knots_v, aero.control_points
     D = scale * aero.degree_v / (V[aero.degree_v + 1] - V[0]) * (P[:, 1] - P[:, 0])
-    cols = [interpolate(root_nets[:, i], q, params=w, end_derivative=D[i]) for i in range(root_nets.shape[1])]
-    net = np.stack([c.control_points for c in cols], axis=0)
+    # every column on the same parameters and knots: one banded system, a right-hand side
+    # column per coordinate of every column (LAPACK solves them independently)
+    n = root_nets.shape[1]
+    cols = interpolate(root_nets.reshape(K, -1), q, params=w, end_derivative=D.reshape(-1))
+    net = np.ascontiguousarray(cols.control_points.reshape(-1, n, root_nets.shape[2]).transpose(1, 0, 2))
     # the end rows are the root section and the first airfoil (shared with the aero surface):
     # the banded solve with the derivative row reproduces them only to rounding
     net[:, 0], net[:, -1] = root_nets[0], P[:, 0]
-    return BSplineSurface(aero.degree_u, q, aero.knots_u, cols[0].knots, net)
+    return BSplineSurface(aero.degree_u, q, aero.knots_u, cols.knots, net)
 
 
 #: Two independently solved copies of a shared row may differ by round-off only; more
