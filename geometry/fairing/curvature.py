@@ -11,6 +11,8 @@ vectorised over parameters.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from ..errors import GeometryError
@@ -50,12 +52,35 @@ def derivatives(curve: BSplineCurve, params, order: int) -> list[np.ndarray]:
     if curve.is_rational:
         D = curve.derivatives(u, order)
         return [D[..., k, :] for k in range(order + 1)]
-    from scipy.interpolate import BSpline
-
     a, b = curve.domain
     u = np.clip(u, a, b)
-    spline = BSpline(curve.knots, curve.control_points, curve.degree, extrapolate=False)
+    spline = _scipy_spline(curve)
     return [spline(u, nu=k) for k in range(order + 1)]
+
+
+def _scipy_spline(curve: BSplineCurve):
+    """The curve as a ``scipy.interpolate.BSpline`` (no extrapolation), made once per
+    curve (curves are immutable) without re-checking the already validated knots: the
+    smoothing evaluates each curve many times at a few points, where building it was most
+    of the cost."""
+    spline = curve.__dict__.get("_fairing_bspline")
+    if spline is None:
+        from scipy.interpolate import BSpline
+
+        spline = BSpline.construct_fast(curve.knots, np.ascontiguousarray(curve.control_points), curve.degree,
+                                        extrapolate=False)
+        curve.__dict__["_fairing_bspline"] = spline
+    return spline
+
+
+@lru_cache(maxsize=None)
+def _gauss_legendre(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre nodes and weights on [-1, 1] (``numpy.polynomial.legendre.leggauss``),
+    computed once per count (read-only)."""
+    x, w = np.polynomial.legendre.leggauss(count)
+    x.flags.writeable = False
+    w.flags.writeable = False
+    return x, w
 
 
 def curvature_at(curve: BSplineCurve, params) -> np.ndarray:
@@ -88,7 +113,7 @@ def arclength_table(curve: BSplineCurve, subdivisions: int = ARCLENGTH_SUBDIVISI
     :data:`ARCLENGTH_GAUSS_NODES`-point Gauss–Legendre quadrature of |C'(u)|.
     """
     t = span_samples(curve, subdivisions)
-    x, w = np.polynomial.legendre.leggauss(ARCLENGTH_GAUSS_NODES)
+    x, w = _gauss_legendre(ARCLENGTH_GAUSS_NODES)
     half = 0.5 * np.diff(t)
     mid = 0.5 * (t[:-1] + t[1:])
     u = mid[:, None] + half[:, None] * x[None, :]

@@ -400,6 +400,13 @@ class _KnotCurvature:
         a, _ = self.derivatives(P)
         return np.stack([-a[:, 1], a[:, 0]], axis=1) / np.hypot(a[:, 0], a[:, 1])[:, None]
 
+    def curvature_and_normals(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`curvature` and :meth:`normals` from one evaluation of the derivatives."""
+        a, b = self.derivatives(P)
+        speed = np.hypot(a[:, 0], a[:, 1])
+        return ((a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / speed**3,
+                np.stack([-a[:, 1], a[:, 0]], axis=1) / speed[:, None])
+
 
 # =======================================================================================
 # step 2: the smoothed curvature target
@@ -524,31 +531,52 @@ def smooth_curvature(
 # =======================================================================================
 # steps 3-5: the Newton/secant iteration
 # =======================================================================================
-def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float, rows: np.ndarray, closed: bool = False) -> np.ndarray:
+def _jacobian_plan(N: int, closed: bool = False) -> list:
+    """The colouring of :func:`_jacobian_bands` for N vertices: per colour, the moved
+    vertices and, per band offset o, the rows i whose vertex i + o is among them. It
+    depends on N only, so one Newton run computes it once."""
+    colour = np.arange(N) % 3
+    if closed and N % 3:
+        colour[N - N % 3 :] = 3 + np.arange(N % 3)
+    i = np.arange(N)
+    plan = []
+    for c in range(int(colour.max()) + 1):
+        moved = colour == c
+        targets = []
+        for o in (-1, 0, 1):
+            j = i + o
+            ok = np.ones(N, dtype=bool) if closed else (j >= 0) & (j < N)
+            j = j % N
+            ok &= moved[j]
+            targets.append((1 + o, i[ok]))
+        plan.append((moved, targets))
+    return plan
+
+
+def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float, rows: np.ndarray, closed: bool = False, plan: list | None = None) -> np.ndarray:
     """Tridiagonal J_ij = ∂κ_i/∂(ε n_j), vertex j ↔ control point ``P[rows[j]]`` (Hvid's
     d_j), as bands[1 + j − i, i] (row i: ∂κ_i/∂d_{i−1}, ∂κ_i/∂d_i, ∂κ_i/∂d_{i+1}; on a
     closed curve the indices wrap, so the corners are bands[0, 0] and bands[2, N−1]).
     Vertices of one colour are moved together, since κ_i only sees d_{i−1}, d_i, d_{i+1}:
     colour j mod 3, and on a closed curve with N not a multiple of 3 the last N mod 3
     vertices get colours of their own so that no two moved vertices are within two of
-    each other across the seam."""
+    each other across the seam (:func:`_jacobian_plan`)."""
     N = kappa.size
-    colour = np.arange(N) % 3
-    if closed and N % 3:
-        colour[N - N % 3 :] = 3 + np.arange(N % 3)
+    if plan is None:
+        plan = _jacobian_plan(N, closed)
     bands = np.zeros((3, N))
-    i = np.arange(N)
-    for c in range(int(colour.max()) + 1):
-        moved = colour == c
-        Q = P.copy()
-        Q[rows[moved]] += step * normals[moved]
-        dk = (op.curvature(Q) - kappa) / step
-        for o in (-1, 0, 1):
-            j = i + o
-            ok = np.ones(N, dtype=bool) if closed else (j >= 0) & (j < N)
-            j = j % N
-            ok &= moved[j]
-            bands[1 + o, i[ok]] = dk[ok]
+    # all colours' perturbed nets at once: κ_i of net c is the same arithmetic as
+    # op.curvature on that net alone (the gathers and sums are per net)
+    Q = np.repeat(P[None], len(plan), axis=0)
+    for c, (moved, _) in enumerate(plan):
+        Q[c, rows[moved]] += step * normals[moved]
+    G = Q[:, op.cols]  # (colours, N, 4, dim)
+    a, b = np.einsum("nk,cnkd->cnd", op.d1, G), np.einsum("nk,cnkd->cnd", op.d2, G)
+    k = (a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]) / np.hypot(a[..., 0], a[..., 1]) ** 3
+    dk = (k - kappa) / step
+    for c, (_, targets) in enumerate(plan):
+        for band, ok in targets:
+            bands[band, ok] = dk[c, ok]
     return bands
 
 
@@ -596,8 +624,9 @@ def newton_curvature(
     history: list[tuple[float, float]] = []
     first = None
     target = np.array(target, dtype=np.float64)
+    plan = _jacobian_plan(N, closed)
     for iteration in range(1, int(max_iterations) + 1):
-        kappa = op.curvature(P)
+        kappa, normals = op.curvature_and_normals(P)
         residual = kappa - target
         errf = float(np.sum(np.abs(residual)))
         if not np.isfinite(errf):
@@ -615,8 +644,7 @@ def newton_curvature(
         if errf > DIVERGENCE_FACTOR * first:
             history.append((errf, float("nan")))
             return build(P), history, False, "the residual diverged"
-        normals = op.normals(P)
-        bands = _jacobian_bands(op, P, kappa, normals, JACOBIAN_STEP, rows, closed)
+        bands = _jacobian_bands(op, P, kappa, normals, JACOBIAN_STEP, rows, closed, plan)
         try:
             delta = _solve_jacobian(bands, -residual, closed)
         except np.linalg.LinAlgError:
