@@ -363,14 +363,23 @@ def _others_farther(S, P, k, d, g, ok):
     band, bvalid = _padded_spans(S, ki, ga[member], G)
     near = _norm(S.centre[band] - Pi[:, None]) - S.radius[band]
     near[~bvalid | (np.abs(band - gi[:, None]) <= 1)] = np.inf
-    done = (beyond >= di) & (near.min(axis=1) >= di)
+    near_ok = near.min(axis=1) >= di
+    done = (beyond >= di) & near_ok
     clear[idx[done]] = True
-    rest = idx[~done]
-    if rest.size == 0:
+    if done.all():
         return clear, none, none
-    t, valid = _padded_spans(S, k[rest])
-    gap = _norm(S.centre[t] - P[rest][:, None]) - S.radius[t]
-    open_ = valid & (np.abs(t - g[rest][:, None]) > 1) & (gap < d[rest][:, None])
-    clear[rest] = ~open_.any(axis=1)
-    i, j = np.nonzero(open_)
-    return clear, rest[i], t[i, j]
+    # the rest: the spans beyond the band that the anchor's bound leaves open, and every
+    # span of the band, get the disc test
+    r = np.flatnonzero(~done)
+    t, valid = _padded_spans(S, ka[member[r]])
+    maybe = gaps[member[r]] - _norm(Pi[r] - Pi[anchor[r]])[:, None] < di[r][:, None]  # beyond the band
+    maybe |= valid & (np.abs(t - ga[member[r]][:, None]) <= G)  # the band
+    maybe &= np.abs(t - gi[r][:, None]) > 1
+    i, j = np.nonzero(maybe)
+    tt = t[i, j]
+    rows = idx[r[i]]
+    gap = _norm(S.centre[tt] - P[rows]) - S.radius[tt]
+    open_ = gap < d[rows]
+    clear[idx[r]] = True
+    clear[rows[open_]] = False
+    return clear, rows[open_], tt[open_]
