@@ -599,13 +599,16 @@ def newton_curvature(
     tolf: float,
     progress: Progress | None = None,
     closed: bool = False,
+    op: "_KnotCurvature | None" = None,
 ) -> tuple[BSplineCurve, list[tuple[float, float]], bool, str]:
     """Steps 3–5 of Hvid (1993) §3.2 on a cubic with knots at ``params`` (reference length
     1). Returns (curve, history of (Σ|κ−κ*|, Σ|δ|), converged, reason). Open curves: the
     end control points P_0 = r_0 and P_{n+2} = r_n never move. Closed (periodic, from
     :func:`periodic_spline_through`): every control point moves, the Jacobian is cyclic
-    tridiagonal, and there is no seam."""
-    op = _KnotCurvature.of(curve, params, closed)
+    tridiagonal, and there is no seam. ``op``: :meth:`_KnotCurvature.of` (curve, params,
+    closed) when the caller has it already (the knots never move)."""
+    if op is None:
+        op = _KnotCurvature.of(curve, params, closed)
     N = target.size
     if closed:
         P = np.array(curve.control_points[:N])
@@ -863,7 +866,7 @@ def _run(
     if closed:
         target = _keep_turning(target, kappa0, unsmoothed, params)
     curve, history, converged, reason = newton_curvature(
-        unsmoothed, params, target, settings.max_iterations, settings.tolx, settings.tolf, progress, closed
+        unsmoothed, params, target, settings.max_iterations, settings.tolx, settings.tolf, progress, closed, op
     )
     if closed:
         curve = _rigid_align(curve, unsmoothed, params)
@@ -1106,7 +1109,10 @@ def _farthest_point(curve: BSplineCurve, origin: np.ndarray) -> float:
         h = np.dot(D[1], D[1]) + np.dot(D[0] - origin, D[2])
         if h >= 0:
             break
-        t = float(np.clip(t - g / h, lo, hi))
+        step = float(np.clip(t - g / h, lo, hi))
+        if step == t:  # a fixed point: the remaining steps would repeat it
+            break
+        t = step
     return float(t)
 
 
