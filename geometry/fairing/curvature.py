@@ -58,6 +58,15 @@ def derivatives(curve: BSplineCurve, params, order: int) -> list[np.ndarray]:
     return [spline(u, nu=k) for k in range(order + 1)]
 
 
+def derivative(curve: BSplineCurve, params, order: int) -> np.ndarray:
+    """C^(order) alone at ``params`` (the entry ``order`` of :func:`derivatives`, the same
+    numbers, without evaluating the lower orders)."""
+    if curve.is_rational:
+        return derivatives(curve, params, order)[order]
+    a, b = curve.domain
+    return _scipy_spline(curve)(np.clip(np.asarray(params, dtype=np.float64), a, b), nu=order)
+
+
 def _scipy_spline(curve: BSplineCurve):
     """The curve as a ``scipy.interpolate.BSpline`` (no extrapolation), made once per
     curve (curves are immutable) without re-checking the already validated knots: the
@@ -117,7 +126,7 @@ def arclength_table(curve: BSplineCurve, subdivisions: int = ARCLENGTH_SUBDIVISI
     half = 0.5 * np.diff(t)
     mid = 0.5 * (t[:-1] + t[1:])
     u = mid[:, None] + half[:, None] * x[None, :]
-    speed = np.linalg.norm(derivatives(curve, u, 1)[1], axis=-1)
+    speed = np.linalg.norm(derivative(curve, u, 1), axis=-1)
     pieces = half * (speed @ w)
     return t, np.concatenate([[0.0], np.cumsum(pieces)])
 
@@ -136,7 +145,7 @@ def params_at_arclength(curve: BSplineCurve, fractions, table=None) -> np.ndarra
     from scipy.interpolate import CubicHermiteSpline
 
     t, s = arclength_table(curve) if table is None else table
-    speed = np.linalg.norm(derivatives(curve, t, 1)[1], axis=-1)
+    speed = np.linalg.norm(derivative(curve, t, 1), axis=-1)
     target = np.clip(np.asarray(fractions, dtype=np.float64), 0.0, 1.0) * s[-1]
     u = CubicHermiteSpline(s, t, 1.0 / np.maximum(speed, 1e-300))(target)
     a, b = curve.domain
