@@ -104,6 +104,29 @@ class _Spans:
         M = monomial_derivatives(u - self.mid[g], self.p, order)
         return np.matmul(M.transpose(1, 0, 2), self.table[g])
 
+    def horner(self, g: np.ndarray, u: np.ndarray, order: int) -> list[np.ndarray]:
+        """[C, C', ...] up to ``order`` (<= 2) at u on spans g by Horner's rule on the span
+        table: fewer operations than :meth:`derivatives` (the Newton steps), equal to
+        rounding."""
+        T = self.table[g]
+        t = (u - self.mid[g])[:, None]
+        p = self.p
+        c = T[:, p]
+        for a in range(p - 1, -1, -1):
+            c = c * t + T[:, a]
+        out = [c]
+        if order >= 1:
+            c = p * T[:, p]
+            for a in range(p - 1, 0, -1):
+                c = c * t + a * T[:, a]
+            out.append(c)
+        if order >= 2:
+            c = (p * (p - 1)) * T[:, p]
+            for a in range(p - 1, 1, -1):
+                c = c * t + (a * (a - 1)) * T[:, a]
+            out.append(c)
+        return out
+
     def same(self, g: np.ndarray, k: np.ndarray) -> np.ndarray:
         """Is g a span (index in range) of curve k?"""
         return (g >= self.first[k]) & (g < self.first[k] + self.count[k])
@@ -193,9 +216,8 @@ def _newton(S: _Spans, P, k, u, lo, hi, eps1, cos_tol, max_iterations) -> np.nda
         if active.size == 0:
             break
         ua, ka = u[active], k[active]
-        D = S.derivatives(S.span(ka, ua), ua, 2)
-        r = D[:, 0] - P[active]
-        d1, d2 = D[:, 1], D[:, 2]
+        c0, d1, d2 = S.horner(S.span(ka, ua), ua, 2)
+        r = c0 - P[active]
         dist = np.sqrt(np.einsum("nd,nd->n", r, r))
         speed2 = np.einsum("nd,nd->n", d1, d1)
         speed = np.sqrt(speed2)
@@ -242,8 +264,8 @@ def _window_minimum(S, P, k, g, u0, eps1, cos_tol, max_iterations):
     glo, ghi = w[:, 0], w[:, 2]
     lo, hi = S.lo[glo], S.hi[ghi]
     m = P.shape[0]
-    ends = S.derivatives(np.concatenate([glo, ghi]), np.concatenate([lo, hi]), 1)
-    f = np.einsum("nd,nd->n", ends[:, 1], ends[:, 0] - np.concatenate([P, P]))
+    c0, c1 = S.horner(np.concatenate([glo, ghi]), np.concatenate([lo, hi]), 1)
+    f = np.einsum("nd,nd->n", c1, c0 - np.concatenate([P, P]))
     f_lo, f_hi = f[:m], f[m:]
     far = _norm(S.centre[w] - P[:, None]) + S.radius[w]
     unique = np.all(~inside | (S.speed[w] ** 2 > S.bend[w] * far), axis=1)
