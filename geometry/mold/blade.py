@@ -198,12 +198,18 @@ def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None
 def data_parameters(split: SplitSection, fit: TwoPartFit) -> tuple[np.ndarray, np.ndarray]:
     """The parameters the fit gave the section's data points (upper_data, lower_data
     order) on its two halves: where their closest points are sought first."""
+    nu, nl = len(split.upper_data), len(split.lower_data)
     pu, pl = fit.params_upper, fit.params_lower
-    if pu is None or pl is None:
-        pu, pl = parameterize(split.upper), parameterize(split.lower)
-    if split.upper_marks is None:
+    if split.upper_marks is not None and pu is not None and pl is not None:
+        return pu[split.upper_marks], pl[split.lower_marks]
+    if pu is not None and pl is not None and len(pu) == nu + 1 and len(pl) == nl + 1:
         return pu[:-1], pl[1:]  # S (interpolated) is the last row of upper, the first of lower
-    return pu[split.upper_marks], pl[split.lower_marks]
+    if pu is not None and pl is not None and nu and nl and (len(pu) - 1) % nu == 0 and (len(pl) - 1) % nl == 0:
+        # fitted to the densified halves (:func:`.sections.densified`): every samples-th row
+        su, sl = (len(pu) - 1) // nu, (len(pl) - 1) // nl
+        return pu[np.arange(nu) * su], pl[(np.arange(nl) + 1) * sl]
+    # no fit parameters: evenly along each half (a start only; the search is global)
+    return np.linspace(0.0, 1.0, nu + 1)[:-1], np.linspace(0.0, 1.0, nl + 1)[1:]
 
 
 def _closest_distances(pairs) -> list[np.ndarray]:
