@@ -32,7 +32,7 @@ from math import factorial
 
 import numpy as np
 
-from .basis import find_span, monomial_derivatives
+from .basis import find_span, monomial_derivatives, taylor_matrices
 from .curve import BSplineCurve
 from .projection import COSINE_TOL, MAX_ITERATIONS, POINT_TOL, _query_points, closest_point_curve
 
@@ -62,9 +62,18 @@ class _Spans:
         start = 0
         self.first = np.empty(len(curves), dtype=np.intp)
         self.count = np.empty(len(curves), dtype=np.intp)
+        shared = {}  # Taylor matrices per knot vector (a blade's sections share theirs)
         for k, c in enumerate(curves):
-            mid, table = c._span_table
             U, n = c.knots, c.n_control
+            if "_span_table" in c.__dict__:
+                mid, table = c._span_table
+            else:  # the curve's span table (BSplineCurve._span_table), its matrices shared
+                key = (U.tobytes(), n)
+                if key not in shared:
+                    shared[key] = taylor_matrices(U, p, n)
+                mid, T = shared[key]
+                windows = np.lib.stride_tricks.sliding_window_view(c.control_points, p + 1, axis=0)
+                table = np.einsum("iac,idc->iad", T, windows)
             br = np.unique(U[p: n + 1])
             i = find_span(U, p, 0.5 * (br[:-1] + br[1:])) - p
             mids.append(mid[i])
