@@ -96,15 +96,20 @@ def curvature_at(curve: BSplineCurve, params) -> np.ndarray:
     """Signed curvature κ = (ẋÿ − ẏẍ)/(ẋ² + ẏ²)^{3/2} at ``params`` (Hvid 1993 Eq. 2.10):
     positive where the curve turns left (anticlockwise). Shape of ``params``."""
     _require_planar(curve)
-    _, d1, d2 = derivatives(curve, params, 2)
+    d1, d2 = derivative(curve, params, 1), derivative(curve, params, 2)
     return (d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]) / np.hypot(d1[..., 0], d1[..., 1]) ** 3
 
 
 def breakpoints(curve: BSplineCurve) -> np.ndarray:
     """Distinct knot values inside the domain, ends included."""
-    a, b = curve.domain
-    U = np.unique(curve.knots)
-    return U[(U >= a) & (U <= b)]
+    br = curve.__dict__.get("_fairing_breakpoints")  # curves are immutable: once per curve
+    if br is None:
+        a, b = curve.domain
+        U = np.unique(curve.knots)
+        br = U[(U >= a) & (U <= b)]
+        br.flags.writeable = False
+        curve.__dict__["_fairing_breakpoints"] = br
+    return br
 
 
 def span_samples(curve: BSplineCurve, per_span: int = PLOT_SAMPLES_PER_SPAN) -> np.ndarray:
