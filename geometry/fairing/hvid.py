@@ -553,7 +553,8 @@ def _jacobian_plan(N: int, closed: bool = False) -> list:
     return plan
 
 
-def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float, rows: np.ndarray, closed: bool = False, plan: list | None = None) -> np.ndarray:
+def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float,
+                    rows: np.ndarray, closed: bool = False, plan: list | None = None) -> np.ndarray:
     """Tridiagonal J_ij = ∂κ_i/∂(ε n_j), vertex j ↔ control point ``P[rows[j]]`` (Hvid's
     d_j), as bands[1 + j − i, i] (row i: ∂κ_i/∂d_{i−1}, ∂κ_i/∂d_i, ∂κ_i/∂d_{i+1}; on a
     closed curve the indices wrap, so the corners are bands[0, 0] and bands[2, N−1]).
@@ -808,8 +809,8 @@ def _dense_extremes(curve: BSplineCurve, sign: float) -> tuple[float, float]:
     return float(k.min()), float(k.max())
 
 
-def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndarray, data: np.ndarray, measure: bool = True,
-               data_params: np.ndarray | None = None) -> Deviation:
+def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndarray, data: np.ndarray,
+               measure: bool = True, data_params: np.ndarray | None = None) -> Deviation:
     """The deviation report. The true distances are closest points (NURBS Book §6.1)
     found from the parameter correspondence (:func:`.nurbs.local_projection.closest_point_curve_near`):
     the smoothed and the unsmoothed curve share their knots and lie close, so each sample's
@@ -821,7 +822,8 @@ def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndar
     if not measure:
         return Deviation(same, float("nan"), float("nan"))
     us = span_samples(smoothed, DEVIATION_SAMPLES_PER_SPAN)
-    ss = us if np.array_equal(smoothed.knots, unsmoothed.knots) else span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)
+    same_knots = np.array_equal(smoothed.knots, unsmoothed.knots)
+    ss = us if same_knots else span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)
     on_smoothed = smoothed.evaluate(us)
     if data_params is None:
         from scipy.spatial import cKDTree

@@ -57,7 +57,7 @@ class _Spans:
     def __init__(self, curves):
         p = curves[0].degree
         self.p = p
-        mids, tables, lo, hi, owner, local_first = [], [], [], [], [], []
+        mids, tables, lo, hi, owner = [], [], [], [], []
         self.size = np.array([max(c.size(), 1e-300) for c in curves])
         start = 0
         self.first = np.empty(len(curves), dtype=np.intp)
