@@ -812,7 +812,7 @@ def _dense_extremes(curve: BSplineCurve, sign: float) -> tuple[float, float]:
 def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndarray, data: np.ndarray,
                measure: bool = True, data_params: np.ndarray | None = None) -> Deviation:
     """The deviation report. The true distances are closest points (NURBS Book §6.1)
-    found from the parameter correspondence (:func:`.nurbs.local_projection.closest_point_curve_near`):
+    found from the parameter correspondence (:func:`..nurbs.local_projection.closest_points_near`):
     the smoothed and the unsmoothed curve share their knots and lie close, so each sample's
     own parameter starts its foot's search on the other curve; the data points start at
     ``data_params`` (their parameters on the smoothed curve, approximately) or, when not
