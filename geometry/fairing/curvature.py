@@ -147,14 +147,33 @@ def params_at_arclength(curve: BSplineCurve, fractions, table=None) -> np.ndarra
     Inverts :func:`arclength_table` with the cubic Hermite interpolant of u(s), whose
     slopes du/ds = 1/|C'(u)| are known at the table points (error O(h⁴) per piece).
     """
-    from scipy.interpolate import CubicHermiteSpline
-
     t, s = arclength_table(curve) if table is None else table
     speed = np.linalg.norm(derivative(curve, t, 1), axis=-1)
     target = np.clip(np.asarray(fractions, dtype=np.float64), 0.0, 1.0) * s[-1]
-    u = CubicHermiteSpline(s, t, 1.0 / np.maximum(speed, 1e-300))(target)
+    u = _hermite(s, t, 1.0 / np.maximum(speed, 1e-300))(target)
     a, b = curve.domain
     return np.clip(u, a, b)
+
+
+def _hermite(x: np.ndarray, y: np.ndarray, dydx: np.ndarray):
+    """``scipy.interpolate.CubicHermiteSpline(x, y, dydx)`` for 1-D float64 data: its
+    piecewise-polynomial coefficients, the same arithmetic, given to ``PPoly`` without
+    the input checks when x increases strictly (the class itself, which refuses the data
+    with its own message, otherwise)."""
+    from scipy.interpolate import CubicHermiteSpline, PPoly
+
+    dx = np.diff(x)
+    if not (x.ndim == 1 and x.size >= 2 and np.all(dx > 0) and np.all(np.isfinite(x))
+            and np.all(np.isfinite(y)) and np.all(np.isfinite(dydx))):
+        return CubicHermiteSpline(x, y, dydx)
+    slope = np.diff(y, axis=0) / dx
+    t = (dydx[:-1] + dydx[1:] - 2 * slope) / dx
+    c = np.empty((4, len(x) - 1), dtype=t.dtype)
+    c[0] = t / dx
+    c[1] = (slope - dydx[:-1]) / dx - t
+    c[2] = dydx[:-1]
+    c[3] = y[:-1]
+    return PPoly.construct_fast(c, x, extrapolate=True)
 
 
 def curvature_plot(curve: BSplineCurve, per_span: int = PLOT_SAMPLES_PER_SPAN) -> tuple[np.ndarray, np.ndarray]:
