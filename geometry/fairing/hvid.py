@@ -584,11 +584,26 @@ def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normal
 def _solve_jacobian(bands: np.ndarray, rhs: np.ndarray, closed: bool) -> np.ndarray:
     if closed:
         return solve_cyclic_tridiagonal(bands[0], bands[1], bands[2], rhs)
-    ab = np.zeros_like(bands)
-    ab[0, 1:] = bands[2, :-1]  # A[i, i+1] at ab[0, i+1]
-    ab[1] = bands[1]
-    ab[2, :-1] = bands[0, 1:]  # A[i, i−1] at ab[2, i−1]
-    return solve_banded((1, 1), ab, rhs)
+    # A[i, i+1] = bands[2, i], A[i, i−1] = bands[0, i]: LAPACK's tridiagonal ?gtsv, the
+    # routine scipy.linalg.solve_banded((1, 1), ...) calls, without its wrapper's work
+    return _solve_tridiagonal(bands[0, 1:], bands[1], bands[2, :-1], rhs)
+
+
+def _solve_tridiagonal(lower: np.ndarray, diag: np.ndarray, upper: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """x with A x = rhs for the tridiagonal A (sub-, main and super-diagonal), by LAPACK
+    dgtsv as ``scipy.linalg.solve_banded`` does for one band each side (the same numbers
+    and errors: ValueError for non-finite input, LinAlgError when singular)."""
+    from scipy.linalg.lapack import dgtsv
+
+    arrays = [np.asarray(a, dtype=np.float64) for a in (lower, diag, upper, rhs)]
+    if not all(np.isfinite(a).all() for a in arrays):
+        raise ValueError("array must not contain infs or NaNs")
+    *_, x, info = dgtsv(*arrays)
+    if info > 0:
+        raise np.linalg.LinAlgError("singular matrix")
+    if info < 0:
+        raise ValueError(f"illegal value in {-info}-th argument of internal gtsv")
+    return x
 
 
 def newton_curvature(
