@@ -532,25 +532,26 @@ def smooth_curvature(
 # steps 3-5: the Newton/secant iteration
 # =======================================================================================
 def _jacobian_plan(N: int, closed: bool = False) -> list:
-    """The colouring of :func:`_jacobian_bands` for N vertices: per colour, the moved
-    vertices and, per band offset o, the rows i whose vertex i + o is among them. It
+    """The colouring of :func:`_jacobian_bands` for N vertices: per colour the moved
+    vertices, and where each band entry comes from (flat indices into the bands and into
+    the colours' curvature changes: entry (1 + o, i) from the colour of vertex i + o). It
     depends on N only, so one Newton run computes it once."""
     colour = np.arange(N) % 3
     if closed and N % 3:
         colour[N - N % 3 :] = 3 + np.arange(N % 3)
     i = np.arange(N)
-    plan = []
+    moved_sets, dst, src = [], [], []
     for c in range(int(colour.max()) + 1):
         moved = colour == c
-        targets = []
         for o in (-1, 0, 1):
             j = i + o
             ok = np.ones(N, dtype=bool) if closed else (j >= 0) & (j < N)
             j = j % N
             ok &= moved[j]
-            targets.append((1 + o, i[ok]))
-        plan.append((moved, targets))
-    return plan
+            dst.append((1 + o) * N + i[ok])  # bands[1 + o, i] (flat)
+            src.append(c * N + i[ok])  # ∂κ_i from the net with colour c moved (flat)
+        moved_sets.append(moved)
+    return [moved_sets, np.concatenate(dst), np.concatenate(src)]
 
 
 def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float,
@@ -565,19 +566,18 @@ def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normal
     N = kappa.size
     if plan is None:
         plan = _jacobian_plan(N, closed)
+    moved_sets, dst, src = plan
     bands = np.zeros((3, N))
     # all colours' perturbed nets at once: κ_i of net c is the same arithmetic as
     # op.curvature on that net alone (the gathers and sums are per net)
-    Q = np.repeat(P[None], len(plan), axis=0)
-    for c, (moved, _) in enumerate(plan):
+    Q = np.repeat(P[None], len(moved_sets), axis=0)
+    for c, moved in enumerate(moved_sets):
         Q[c, rows[moved]] += step * normals[moved]
     G = Q[:, op.cols]  # (colours, N, 4, dim)
     a, b = np.einsum("nk,cnkd->cnd", op.d1, G), np.einsum("nk,cnkd->cnd", op.d2, G)
     k = (a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]) / np.hypot(a[..., 0], a[..., 1]) ** 3
     dk = (k - kappa) / step
-    for c, (_, targets) in enumerate(plan):
-        for band, ok in targets:
-            bands[band, ok] = dk[c, ok]
+    bands.reshape(-1)[dst] = dk.reshape(-1)[src]
     return bands
 
 
