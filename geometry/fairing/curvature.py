@@ -11,6 +11,8 @@ vectorised over parameters.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from ..errors import GeometryError
@@ -50,27 +52,64 @@ def derivatives(curve: BSplineCurve, params, order: int) -> list[np.ndarray]:
     if curve.is_rational:
         D = curve.derivatives(u, order)
         return [D[..., k, :] for k in range(order + 1)]
-    from scipy.interpolate import BSpline
-
     a, b = curve.domain
     u = np.clip(u, a, b)
-    spline = BSpline(curve.knots, curve.control_points, curve.degree, extrapolate=False)
+    spline = _scipy_spline(curve)
     return [spline(u, nu=k) for k in range(order + 1)]
+
+
+def derivative(curve: BSplineCurve, params, order: int) -> np.ndarray:
+    """C^(order) alone at ``params`` (the entry ``order`` of :func:`derivatives`, the same
+    numbers, without evaluating the lower orders)."""
+    if curve.is_rational:
+        return derivatives(curve, params, order)[order]
+    a, b = curve.domain
+    return _scipy_spline(curve)(np.clip(np.asarray(params, dtype=np.float64), a, b), nu=order)
+
+
+def _scipy_spline(curve: BSplineCurve):
+    """The curve as a ``scipy.interpolate.BSpline`` (no extrapolation), made once per
+    curve (curves are immutable) without re-checking the already validated knots: the
+    smoothing evaluates each curve many times at a few points, where building it was most
+    of the cost."""
+    spline = curve.__dict__.get("_fairing_bspline")
+    if spline is None:
+        from scipy.interpolate import BSpline
+
+        spline = BSpline.construct_fast(curve.knots, np.ascontiguousarray(curve.control_points), curve.degree,
+                                        extrapolate=False)
+        curve.__dict__["_fairing_bspline"] = spline
+    return spline
+
+
+@lru_cache(maxsize=None)
+def _gauss_legendre(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre nodes and weights on [-1, 1] (``numpy.polynomial.legendre.leggauss``),
+    computed once per count (read-only)."""
+    x, w = np.polynomial.legendre.leggauss(count)
+    x.flags.writeable = False
+    w.flags.writeable = False
+    return x, w
 
 
 def curvature_at(curve: BSplineCurve, params) -> np.ndarray:
     """Signed curvature κ = (ẋÿ − ẏẍ)/(ẋ² + ẏ²)^{3/2} at ``params`` (Hvid 1993 Eq. 2.10):
     positive where the curve turns left (anticlockwise). Shape of ``params``."""
     _require_planar(curve)
-    _, d1, d2 = derivatives(curve, params, 2)
+    d1, d2 = derivative(curve, params, 1), derivative(curve, params, 2)
     return (d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0]) / np.hypot(d1[..., 0], d1[..., 1]) ** 3
 
 
 def breakpoints(curve: BSplineCurve) -> np.ndarray:
     """Distinct knot values inside the domain, ends included."""
-    a, b = curve.domain
-    U = np.unique(curve.knots)
-    return U[(U >= a) & (U <= b)]
+    br = curve.__dict__.get("_fairing_breakpoints")  # curves are immutable: once per curve
+    if br is None:
+        a, b = curve.domain
+        U = np.unique(curve.knots)
+        br = U[(U >= a) & (U <= b)]
+        br.flags.writeable = False
+        curve.__dict__["_fairing_breakpoints"] = br
+    return br
 
 
 def span_samples(curve: BSplineCurve, per_span: int = PLOT_SAMPLES_PER_SPAN) -> np.ndarray:
@@ -88,11 +127,11 @@ def arclength_table(curve: BSplineCurve, subdivisions: int = ARCLENGTH_SUBDIVISI
     :data:`ARCLENGTH_GAUSS_NODES`-point Gauss–Legendre quadrature of |C'(u)|.
     """
     t = span_samples(curve, subdivisions)
-    x, w = np.polynomial.legendre.leggauss(ARCLENGTH_GAUSS_NODES)
+    x, w = _gauss_legendre(ARCLENGTH_GAUSS_NODES)
     half = 0.5 * np.diff(t)
     mid = 0.5 * (t[:-1] + t[1:])
     u = mid[:, None] + half[:, None] * x[None, :]
-    speed = np.linalg.norm(derivatives(curve, u, 1)[1], axis=-1)
+    speed = np.linalg.norm(derivative(curve, u, 1), axis=-1)
     pieces = half * (speed @ w)
     return t, np.concatenate([[0.0], np.cumsum(pieces)])
 
@@ -108,14 +147,33 @@ def params_at_arclength(curve: BSplineCurve, fractions, table=None) -> np.ndarra
     Inverts :func:`arclength_table` with the cubic Hermite interpolant of u(s), whose
     slopes du/ds = 1/|C'(u)| are known at the table points (error O(h⁴) per piece).
     """
-    from scipy.interpolate import CubicHermiteSpline
-
     t, s = arclength_table(curve) if table is None else table
-    speed = np.linalg.norm(derivatives(curve, t, 1)[1], axis=-1)
+    speed = np.linalg.norm(derivative(curve, t, 1), axis=-1)
     target = np.clip(np.asarray(fractions, dtype=np.float64), 0.0, 1.0) * s[-1]
-    u = CubicHermiteSpline(s, t, 1.0 / np.maximum(speed, 1e-300))(target)
+    u = _hermite(s, t, 1.0 / np.maximum(speed, 1e-300))(target)
     a, b = curve.domain
     return np.clip(u, a, b)
+
+
+def _hermite(x: np.ndarray, y: np.ndarray, dydx: np.ndarray):
+    """``scipy.interpolate.CubicHermiteSpline(x, y, dydx)`` for 1-D float64 data: its
+    piecewise-polynomial coefficients, the same arithmetic, given to ``PPoly`` without
+    the input checks when x increases strictly (the class itself, which refuses the data
+    with its own message, otherwise)."""
+    from scipy.interpolate import CubicHermiteSpline, PPoly
+
+    dx = np.diff(x)
+    if not (x.ndim == 1 and x.size >= 2 and np.all(dx > 0) and np.all(np.isfinite(x))
+            and np.all(np.isfinite(y)) and np.all(np.isfinite(dydx))):
+        return CubicHermiteSpline(x, y, dydx)
+    slope = np.diff(y, axis=0) / dx
+    t = (dydx[:-1] + dydx[1:] - 2 * slope) / dx
+    c = np.empty((4, len(x) - 1), dtype=t.dtype)
+    c[0] = t / dx
+    c[1] = (slope - dydx[:-1]) / dx - t
+    c[2] = dydx[:-1]
+    c[3] = y[:-1]
+    return PPoly.construct_fast(c, x, extrapolate=True)
 
 
 def curvature_plot(curve: BSplineCurve, per_span: int = PLOT_SAMPLES_PER_SPAN) -> tuple[np.ndarray, np.ndarray]:

@@ -56,6 +56,7 @@ from ..files import atomic_write
 from ..errors import DefinitionError, GeometryError
 from ..nurbs import BSplineCurve, closest_point_curve, split
 from ..nurbs.basis import basis_function_derivatives, basis_functions, find_span
+from ..nurbs.local_projection import closest_points_near
 from .curvature import arclength_table, curvature_at, derivatives, params_at_arclength, span_samples
 from .distributions import DistributionReport, PolynomialDistribution, curvature_fractions, distribution_report
 
@@ -399,6 +400,13 @@ class _KnotCurvature:
         a, _ = self.derivatives(P)
         return np.stack([-a[:, 1], a[:, 0]], axis=1) / np.hypot(a[:, 0], a[:, 1])[:, None]
 
+    def curvature_and_normals(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`curvature` and :meth:`normals` from one evaluation of the derivatives."""
+        a, b = self.derivatives(P)
+        speed = np.hypot(a[:, 0], a[:, 1])
+        return ((a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) / speed**3,
+                np.stack([-a[:, 1], a[:, 0]], axis=1) / speed[:, None])
+
 
 # =======================================================================================
 # step 2: the smoothed curvature target
@@ -523,42 +531,79 @@ def smooth_curvature(
 # =======================================================================================
 # steps 3-5: the Newton/secant iteration
 # =======================================================================================
-def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float, rows: np.ndarray, closed: bool = False) -> np.ndarray:
+def _jacobian_plan(N: int, closed: bool = False) -> list:
+    """The colouring of :func:`_jacobian_bands` for N vertices: per colour the moved
+    vertices, and where each band entry comes from (flat indices into the bands and into
+    the colours' curvature changes: entry (1 + o, i) from the colour of vertex i + o). It
+    depends on N only, so one Newton run computes it once."""
+    colour = np.arange(N) % 3
+    if closed and N % 3:
+        colour[N - N % 3 :] = 3 + np.arange(N % 3)
+    i = np.arange(N)
+    moved_sets, dst, src = [], [], []
+    for c in range(int(colour.max()) + 1):
+        moved = colour == c
+        for o in (-1, 0, 1):
+            j = i + o
+            ok = np.ones(N, dtype=bool) if closed else (j >= 0) & (j < N)
+            j = j % N
+            ok &= moved[j]
+            dst.append((1 + o) * N + i[ok])  # bands[1 + o, i] (flat)
+            src.append(c * N + i[ok])  # ∂κ_i from the net with colour c moved (flat)
+        moved_sets.append(moved)
+    return [moved_sets, np.concatenate(dst), np.concatenate(src)]
+
+
+def _jacobian_bands(op: _KnotCurvature, P: np.ndarray, kappa: np.ndarray, normals: np.ndarray, step: float,
+                    rows: np.ndarray, closed: bool = False, plan: list | None = None) -> np.ndarray:
     """Tridiagonal J_ij = ∂κ_i/∂(ε n_j), vertex j ↔ control point ``P[rows[j]]`` (Hvid's
     d_j), as bands[1 + j − i, i] (row i: ∂κ_i/∂d_{i−1}, ∂κ_i/∂d_i, ∂κ_i/∂d_{i+1}; on a
     closed curve the indices wrap, so the corners are bands[0, 0] and bands[2, N−1]).
     Vertices of one colour are moved together, since κ_i only sees d_{i−1}, d_i, d_{i+1}:
     colour j mod 3, and on a closed curve with N not a multiple of 3 the last N mod 3
     vertices get colours of their own so that no two moved vertices are within two of
-    each other across the seam."""
+    each other across the seam (:func:`_jacobian_plan`)."""
     N = kappa.size
-    colour = np.arange(N) % 3
-    if closed and N % 3:
-        colour[N - N % 3 :] = 3 + np.arange(N % 3)
+    if plan is None:
+        plan = _jacobian_plan(N, closed)
+    moved_sets, dst, src = plan
     bands = np.zeros((3, N))
-    i = np.arange(N)
-    for c in range(int(colour.max()) + 1):
-        moved = colour == c
-        Q = P.copy()
-        Q[rows[moved]] += step * normals[moved]
-        dk = (op.curvature(Q) - kappa) / step
-        for o in (-1, 0, 1):
-            j = i + o
-            ok = np.ones(N, dtype=bool) if closed else (j >= 0) & (j < N)
-            j = j % N
-            ok &= moved[j]
-            bands[1 + o, i[ok]] = dk[ok]
+    # all colours' perturbed nets at once: κ_i of net c is the same arithmetic as
+    # op.curvature on that net alone (the gathers and sums are per net)
+    Q = np.repeat(P[None], len(moved_sets), axis=0)
+    for c, moved in enumerate(moved_sets):
+        Q[c, rows[moved]] += step * normals[moved]
+    G = Q[:, op.cols]  # (colours, N, 4, dim)
+    a, b = np.einsum("nk,cnkd->cnd", op.d1, G), np.einsum("nk,cnkd->cnd", op.d2, G)
+    k = (a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]) / np.hypot(a[..., 0], a[..., 1]) ** 3
+    dk = (k - kappa) / step
+    bands.reshape(-1)[dst] = dk.reshape(-1)[src]
     return bands
 
 
 def _solve_jacobian(bands: np.ndarray, rhs: np.ndarray, closed: bool) -> np.ndarray:
     if closed:
         return solve_cyclic_tridiagonal(bands[0], bands[1], bands[2], rhs)
-    ab = np.zeros_like(bands)
-    ab[0, 1:] = bands[2, :-1]  # A[i, i+1] at ab[0, i+1]
-    ab[1] = bands[1]
-    ab[2, :-1] = bands[0, 1:]  # A[i, i−1] at ab[2, i−1]
-    return solve_banded((1, 1), ab, rhs)
+    # A[i, i+1] = bands[2, i], A[i, i−1] = bands[0, i]: LAPACK's tridiagonal ?gtsv, the
+    # routine scipy.linalg.solve_banded((1, 1), ...) calls, without its wrapper's work
+    return _solve_tridiagonal(bands[0, 1:], bands[1], bands[2, :-1], rhs)
+
+
+def _solve_tridiagonal(lower: np.ndarray, diag: np.ndarray, upper: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """x with A x = rhs for the tridiagonal A (sub-, main and super-diagonal), by LAPACK
+    dgtsv as ``scipy.linalg.solve_banded`` does for one band each side (the same numbers
+    and errors: ValueError for non-finite input, LinAlgError when singular)."""
+    from scipy.linalg.lapack import dgtsv
+
+    arrays = [np.asarray(a, dtype=np.float64) for a in (lower, diag, upper, rhs)]
+    if not all(np.isfinite(a).all() for a in arrays):
+        raise ValueError("array must not contain infs or NaNs")
+    *_, x, info = dgtsv(*arrays)
+    if info > 0:
+        raise np.linalg.LinAlgError("singular matrix")
+    if info < 0:
+        raise ValueError(f"illegal value in {-info}-th argument of internal gtsv")
+    return x
 
 
 def newton_curvature(
@@ -570,13 +615,16 @@ def newton_curvature(
     tolf: float,
     progress: Progress | None = None,
     closed: bool = False,
+    op: "_KnotCurvature | None" = None,
 ) -> tuple[BSplineCurve, list[tuple[float, float]], bool, str]:
     """Steps 3–5 of Hvid (1993) §3.2 on a cubic with knots at ``params`` (reference length
     1). Returns (curve, history of (Σ|κ−κ*|, Σ|δ|), converged, reason). Open curves: the
     end control points P_0 = r_0 and P_{n+2} = r_n never move. Closed (periodic, from
     :func:`periodic_spline_through`): every control point moves, the Jacobian is cyclic
-    tridiagonal, and there is no seam."""
-    op = _KnotCurvature.of(curve, params, closed)
+    tridiagonal, and there is no seam. ``op``: :meth:`_KnotCurvature.of` (curve, params,
+    closed) when the caller has it already (the knots never move)."""
+    if op is None:
+        op = _KnotCurvature.of(curve, params, closed)
     N = target.size
     if closed:
         P = np.array(curve.control_points[:N])
@@ -595,8 +643,9 @@ def newton_curvature(
     history: list[tuple[float, float]] = []
     first = None
     target = np.array(target, dtype=np.float64)
+    plan = _jacobian_plan(N, closed)
     for iteration in range(1, int(max_iterations) + 1):
-        kappa = op.curvature(P)
+        kappa, normals = op.curvature_and_normals(P)
         residual = kappa - target
         errf = float(np.sum(np.abs(residual)))
         if not np.isfinite(errf):
@@ -614,8 +663,7 @@ def newton_curvature(
         if errf > DIVERGENCE_FACTOR * first:
             history.append((errf, float("nan")))
             return build(P), history, False, "the residual diverged"
-        normals = op.normals(P)
-        bands = _jacobian_bands(op, P, kappa, normals, JACOBIAN_STEP, rows, closed)
+        bands = _jacobian_bands(op, P, kappa, normals, JACOBIAN_STEP, rows, closed, plan)
         try:
             delta = _solve_jacobian(bands, -residual, closed)
         except np.linalg.LinAlgError:
@@ -776,18 +824,33 @@ def _dense_extremes(curve: BSplineCurve, sign: float) -> tuple[float, float]:
     return float(k.min()), float(k.max())
 
 
-def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndarray, data: np.ndarray, measure: bool = True) -> Deviation:
+def _deviation(smoothed: BSplineCurve, unsmoothed: BSplineCurve, params: np.ndarray, data: np.ndarray,
+               measure: bool = True, data_params: np.ndarray | None = None) -> Deviation:
+    """The deviation report. The true distances are closest points (NURBS Book §6.1)
+    found from the parameter correspondence (:func:`..nurbs.local_projection.closest_points_near`):
+    the smoothed and the unsmoothed curve share their knots and lie close, so each sample's
+    own parameter starts its foot's search on the other curve; the data points start at
+    ``data_params`` (their parameters on the smoothed curve, approximately) or, when not
+    given, at the nearest sample. The closest points are certified global there, and
+    found by the general search where they cannot be."""
     same = float(np.max(np.linalg.norm(smoothed.evaluate(params) - unsmoothed.evaluate(params), axis=1)))
     if not measure:
         return Deviation(same, float("nan"), float("nan"))
     us = span_samples(smoothed, DEVIATION_SAMPLES_PER_SPAN)
-    # the curves are close, each knot span short and gently curved: 4 bracket samples per
-    # span (the projection refines them where the curve turns) find every foot
-    k = DEVIATION_BRACKET_SAMPLES
-    _, d1 = closest_point_curve(unsmoothed, smoothed.evaluate(us), samples_per_span=k)
-    _, d2 = closest_point_curve(smoothed, unsmoothed.evaluate(span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)),
-                                samples_per_span=k)
-    _, d3 = closest_point_curve(smoothed, data, samples_per_span=k)
+    same_knots = np.array_equal(smoothed.knots, unsmoothed.knots)
+    ss = us if same_knots else span_samples(unsmoothed, DEVIATION_SAMPLES_PER_SPAN)
+    on_smoothed = smoothed.evaluate(us)
+    if data_params is None:
+        from scipy.spatial import cKDTree
+
+        data_params = us[cKDTree(on_smoothed).query(data)[1]]
+    # one pass: the smoothed samples onto the unsmoothed curve (0), the unsmoothed samples
+    # and the data onto the smoothed one (1)
+    n1, n2 = us.size, ss.size
+    _, d = closest_points_near([unsmoothed, smoothed], np.concatenate([on_smoothed, unsmoothed.evaluate(ss), data]),
+                               np.concatenate([us, ss, np.asarray(data_params, dtype=np.float64)]),
+                               np.repeat([0, 1, 1], [n1, n2, len(data)]))
+    d1, d2, d3 = d[:n1], d[n1: n1 + n2], d[n1 + n2:]
     t, s = arclength_table(smoothed, DEVIATION_SAMPLES_PER_SPAN)
     return Deviation(same, float(max(d1.max(), d2.max())), float(d3.max()), (s / s[-1], d1))
 
@@ -820,7 +883,7 @@ def _run(
     if closed:
         target = _keep_turning(target, kappa0, unsmoothed, params)
     curve, history, converged, reason = newton_curvature(
-        unsmoothed, params, target, settings.max_iterations, settings.tolx, settings.tolf, progress, closed
+        unsmoothed, params, target, settings.max_iterations, settings.tolx, settings.tolf, progress, closed, op
     )
     if closed:
         curve = _rigid_align(curve, unsmoothed, params)
@@ -828,7 +891,7 @@ def _run(
     if converged and rescale_chord is not None:
         curve, chord_scale = rescale_chord(curve, unsmoothed)
     kappa1 = op.curvature(curve.control_points)
-    return unsmoothed, params, curve, kappa0, target, kappa1, history, converged, reason, report, chord_scale
+    return unsmoothed, params, curve, kappa0, target, kappa1, history, converged, reason, report, chord_scale, u_src
 
 
 def _keep_turning(target: np.ndarray, kappa: np.ndarray, curve: BSplineCurve, params: np.ndarray) -> np.ndarray:
@@ -980,7 +1043,7 @@ def smooth2d(
     # closed: one more fraction, the last (= 1) repeating the first point of the loop
     fractions = curvature_fractions(source, settings.smoothing_points + int(closed), alpha)
     output_fractions = curvature_fractions(source, settings.output_points, alpha)
-    (unsmoothed, params, curve, k0, target, k1, history, converged, reason, report, _) = _run(
+    (unsmoothed, params, curve, k0, target, k1, history, converged, reason, report, _, _) = _run(
         source, fractions, output_fractions, settings, progress, closed=closed
     )
     if not converged and raise_on_failure:
@@ -1063,7 +1126,10 @@ def _farthest_point(curve: BSplineCurve, origin: np.ndarray) -> float:
         h = np.dot(D[1], D[1]) + np.dot(D[0] - origin, D[2])
         if h >= 0:
             break
-        t = float(np.clip(t - g / h, lo, hi))
+        step = float(np.clip(t - g / h, lo, hi))
+        if step == t:  # a fixed point: the remaining steps would repeat it
+            break
+        t = step
     return float(t)
 
 
@@ -1170,7 +1236,7 @@ def smoothfoil(
     # area sign: the outline runs clockwise (< 0) or anticlockwise; convex is positive
     x, y = work[:, 0], work[:, 1]
     sign = 1.0 if np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) > 0 else -1.0
-    source, _ = spline_through(work, settings.end_derivative_order)
+    source, work_params = spline_through(work, settings.end_derivative_order)
     apex = work[0].copy()
 
     def rescale_chord(curve: BSplineCurve, unsmoothed: BSplineCurve) -> tuple[BSplineCurve, float]:
@@ -1189,7 +1255,7 @@ def smoothfoil(
 
     fractions = distribution.fractions(settings.smoothing_points)
     output_fractions = distribution.fractions(settings.output_points)
-    (unsmoothed, params, curve, k0_, target, k1_, history, converged, reason, report, factor) = _run(
+    (unsmoothed, params, curve, k0_, target, k1_, history, converged, reason, report, factor, u_src) = _run(
         source, fractions, output_fractions, settings, progress, rescale_chord if rescale else None
     )
     if not converged and raise_on_failure:
@@ -1204,7 +1270,8 @@ def smoothfoil(
         cut = split(split(curve, float(ua))[1], float(ub))[0]
         inside = (u_out > ua) & (u_out < ub)
         out_points = np.concatenate([cut.evaluate(cut.domain[0])[None], out_points[inside], cut.evaluate(cut.domain[1])[None]])
-    deviation = _deviation(curve, unsmoothed, params, work, measure)
+    # the data's parameters on the smoothed curve, about: source -> knot parameters (same knots as curve)
+    deviation = _deviation(curve, unsmoothed, params, work, measure, np.interp(work_params, u_src, params))
     # back to the input frame: x ↦ le + chord · Rᵀ (le2 + chord2 R2ᵀ x)
     Rt, R2t = R.T, R2.T
 

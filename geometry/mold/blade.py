@@ -30,6 +30,7 @@ import numpy as np
 from ..errors import BladesmithError, GeometryError
 from ..nurbs import BSplineCurve, BSplineSurface, interpolate, skin
 from ..nurbs.fitting import approximation_knots, parameterize
+from ..nurbs.local_projection import closest_points_near
 from ..nurbs.projection import closest_point_curve
 from ..nurbs.skinning import skin_parameters
 from .definition import BladeDefinition
@@ -172,9 +173,11 @@ def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None
         return {"params_upper": aligned_parameters(splits[k].upper, Ku, degree),
                 "params_lower": aligned_parameters(splits[k].lower, Kl, degree)}
 
+    halves = {}  # per station: the halves' solutions, shared by its free and constrained fits
+
     def fit(k, **kw):
         try:
-            return fit_two_part(splits[k], Ku, Kl, degree=degree, **params(k), **kw)
+            return fit_two_part(splits[k], Ku, Kl, degree=degree, **params(k), **kw, cache=halves.setdefault(k, {}))
         except BladesmithError as exc:
             st = defn.stations[k]
             raise StationFitError(f"station {k} (r = {st.r:g} m, airfoil {st.airfoil_name or st.airfoil.name!r}): "
@@ -192,11 +195,38 @@ def _fit_all(splits, aero, n, degree, defn, align: bool = False, magnitudes=None
     return [fit(k, ratio=rho) for k in range(len(splits))], rho
 
 
+def data_parameters(split: SplitSection, fit: TwoPartFit) -> tuple[np.ndarray, np.ndarray]:
+    """The parameters the fit gave the section's data points (upper_data, lower_data
+    order) on its two halves: where their closest points are sought first."""
+    nu, nl = len(split.upper_data), len(split.lower_data)
+    pu, pl = fit.params_upper, fit.params_lower
+    if split.upper_marks is not None and pu is not None and pl is not None:
+        return pu[split.upper_marks], pl[split.lower_marks]
+    if pu is not None and pl is not None and len(pu) == nu + 1 and len(pl) == nl + 1:
+        return pu[:-1], pl[1:]  # S (interpolated) is the last row of upper, the first of lower
+    if pu is not None and pl is not None and nu and nl and (len(pu) - 1) % nu == 0 and (len(pl) - 1) % nl == 0:
+        # fitted to the densified halves (:func:`.sections.densified`): every samples-th row
+        su, sl = (len(pu) - 1) // nu, (len(pl) - 1) // nl
+        return pu[np.arange(nu) * su], pl[(np.arange(nl) + 1) * sl]
+    # no fit parameters: evenly along each half (a start only; the search is global)
+    return np.linspace(0.0, 1.0, nu + 1)[:-1], np.linspace(0.0, 1.0, nl + 1)[1:]
+
+
+def _closest_distances(pairs) -> list[np.ndarray]:
+    """Closest-point distances of each (curve, points, guess) of ``pairs``, all in one
+    pass (:func:`..nurbs.local_projection.closest_points_near`, certified global)."""
+    counts = [len(P) for _, P, _ in pairs]
+    _, d = closest_points_near([c for c, _, _ in pairs], np.concatenate([P for _, P, _ in pairs]),
+                               np.concatenate([g for _, _, g in pairs]), np.repeat(np.arange(len(pairs)), counts))
+    return np.split(d, np.cumsum(counts)[:-1])
+
+
 def section_deviation(split: SplitSection, fit: TwoPartFit) -> float:
     """Largest closest-point distance of the section's data to its two fitted halves,
     as a fraction of the chord."""
-    du = closest_point_curve(fit.upper, split.points[split.upper_data])[1]
-    dl = closest_point_curve(fit.lower, split.points[split.lower_data])[1]
+    gu, gl = data_parameters(split, fit)
+    du, dl = _closest_distances([(fit.upper, split.points[split.upper_data], gu),
+                                 (fit.lower, split.points[split.lower_data], gl)])
     return float(max(du.max(), dl.max()) / split.chord)
 
 
@@ -226,12 +256,15 @@ def root_transition(root_nets, aero: BSplineSurface, w, scale: float, degree_w: 
     q = min(degree_w, K)
     V, P = aero.knots_v, aero.control_points
     D = scale * aero.degree_v / (V[aero.degree_v + 1] - V[0]) * (P[:, 1] - P[:, 0])
-    cols = [interpolate(root_nets[:, i], q, params=w, end_derivative=D[i]) for i in range(root_nets.shape[1])]
-    net = np.stack([c.control_points for c in cols], axis=0)
+    # every column on the same parameters and knots: one banded system, a right-hand side
+    # column per coordinate of every column (LAPACK solves them independently)
+    n = root_nets.shape[1]
+    cols = interpolate(root_nets.reshape(K, -1), q, params=w, end_derivative=D.reshape(-1))
+    net = np.ascontiguousarray(cols.control_points.reshape(-1, n, root_nets.shape[2]).transpose(1, 0, 2))
     # the end rows are the root section and the first airfoil (shared with the aero surface):
     # the banded solve with the derivative row reproduces them only to rounding
     net[:, 0], net[:, -1] = root_nets[0], P[:, 0]
-    return BSplineSurface(aero.degree_u, q, aero.knots_u, cols[0].knots, net)
+    return BSplineSurface(aero.degree_u, q, aero.knots_u, cols.knots, net)
 
 
 #: Two independently solved copies of a shared row may differ by round-off only; more
@@ -723,7 +756,7 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
 
     # tolerance by closest-point distance to the skinned surfaces' sections
     t0 = time.perf_counter()
-    reports = []
+    reports, pairs = [], []
     for k, (sp, f) in enumerate(zip(splits, fits)):
         rep = StationReport(k, defn.stations[k].r, sp.chord, f.lsq_error,
                             single_fits[k].lsq_error if k in single_fits else float("nan"),
@@ -733,10 +766,12 @@ def build_blade(defn: BladeDefinition, control_points: int | None = None, tolera
             cu, cl = upper.iso_curve("v", v[j]), lower.iso_curve("v", v[j])
         else:
             cu, cl = tr_u.iso_curve("v", w[k]), tr_l.iso_curve("v", w[k])
-        du = closest_point_curve(cu, sp.points[sp.upper_data])[1]
-        dl = closest_point_curve(cl, sp.points[sp.lower_data])[1]
-        rep.deviation_two_part = float(max(du.max(), dl.max()) / sp.chord)
+        gu, gl = data_parameters(sp, f)  # the iso-curves have the fits' knots
+        pairs += [(cu, sp.points[sp.upper_data], gu), (cl, sp.points[sp.lower_data], gl)]
         reports.append(rep)
+    dist = _closest_distances(pairs)  # every station's closest points in one pass
+    for k, (rep, sp) in enumerate(zip(reports, splits)):
+        rep.deviation_two_part = float(max(dist[2 * k].max(), dist[2 * k + 1].max()) / sp.chord)
     times["tolerance_check"] = time.perf_counter() - t0
     tick(0.85)
 

@@ -346,6 +346,10 @@ class TwoPartFit:
     lsq_error: float
     max_residual: float
     slsqp_iterations: int
+    #: The halves' data parameters (every row of the split's halves, S included): where
+    #: the closest-point measurements start (:func:`~.blade.data_parameters`).
+    params_upper: np.ndarray | None = None
+    params_lower: np.ndarray | None = None
 
 
 def default_knots(points, n_control: int, degree: int = SECTION_DEGREE) -> np.ndarray:
@@ -374,7 +378,7 @@ def aligned_parameters(points, knots, degree: int = SECTION_DEGREE) -> np.ndarra
 
 def fit_two_part(split: SplitSection, knots_upper=None, knots_lower=None, n_control: int = 12,
                  degree: int = SECTION_DEGREE, ratio: float | None = None, params_upper=None,
-                 params_lower=None, magnitudes=None) -> TwoPartFit:
+                 params_lower=None, magnitudes=None, cache: dict | None = None) -> TwoPartFit:
     """Two constrained least-squares fits with G1 at S and the tangent magnitudes by SQP.
 
     knots_upper / knots_lower: the knot vectors of the halves (e.g. the blade's common ones,
@@ -387,11 +391,19 @@ def fit_two_part(split: SplitSection, knots_upper=None, knots_lower=None, n_cont
     params_upper / params_lower: the halves' data parameters (default chord length; see
     :func:`aligned_parameters`). magnitudes: (λ_u, λ_l) set by hand instead of by SQP
     (the tangent magnitude at S of Hosseini Fig. 7a, in units of the halves' parameters).
+    cache: a dict kept by the caller for refits of the same split on the same knots and
+    parameters (a blade's free, then constrained fits): the two halves' least-squares
+    solutions, which do not depend on the magnitudes, are solved once.
     """
-    Ku = default_knots(split.upper, n_control, degree) if knots_upper is None else np.asarray(knots_upper)
-    Kl = default_knots(split.lower, n_control, degree) if knots_lower is None else np.asarray(knots_lower)
-    up = _AffineHalf(split.upper, Ku, degree, split.tangent, at_start=False, params=params_upper)
-    lo = _AffineHalf(split.lower, Kl, degree, split.tangent, at_start=True, params=params_lower)
+    if cache is not None and "halves" in cache:
+        up, lo = cache["halves"]
+    else:
+        Ku = default_knots(split.upper, n_control, degree) if knots_upper is None else np.asarray(knots_upper)
+        Kl = default_knots(split.lower, n_control, degree) if knots_lower is None else np.asarray(knots_lower)
+        up = _AffineHalf(split.upper, Ku, degree, split.tangent, at_start=False, params=params_upper)
+        lo = _AffineHalf(split.lower, Kl, degree, split.tangent, at_start=True, params=params_lower)
+        if cache is not None:
+            cache["halves"] = (up, lo)
     if magnitudes is not None:
         lam_u, lam_l = (float(x) for x in magnitudes)
         if not (lam_u > 0 and lam_l > 0 and np.isfinite(lam_u) and np.isfinite(lam_l)):
@@ -428,7 +440,7 @@ def _finish(up: _AffineHalf, lo: _AffineHalf, split: SplitSection, lam_u: float,
     rl = rl[1:] if split.lower_marks is None else rl[split.lower_marks]
     err = float(np.sum(ru**2) + np.sum(rl**2))
     mx = float(max(np.linalg.norm(ru, axis=1).max(), np.linalg.norm(rl, axis=1).max()))
-    return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, iterations)
+    return TwoPartFit(cu, cl, float(lam_u), float(lam_l), err, mx, iterations, up.params, lo.params)
 
 
 @dataclass(frozen=True, eq=False)

@@ -39,6 +39,24 @@ def test_every_section_within_tolerance(nrel):
     assert np.all(dev <= nrel.definition.tolerance)
 
 
+def test_station_deviations_are_the_general_closest_point_search(nrel):
+    # the tolerance check seeks every station's closest points in one pass from the fit's
+    # parameters (nurbs/local_projection.py); the general search per curve agrees
+    from bladesmith.geometry.mold.blade import blade_sections
+    from bladesmith.geometry.nurbs import closest_point_curve
+
+    splits = blade_sections(nrel.definition)
+    k0 = nrel.definition.first_aerodynamic_station
+    for k, (sp, rep) in enumerate(zip(splits, nrel.stations)):
+        if k < k0:
+            continue  # the root-transition stations: on the transition surfaces (w), not checked here
+        v = nrel.section_params[k - k0]
+        du = closest_point_curve(nrel.upper.iso_curve("v", v), sp.points[sp.upper_data])[1]
+        dl = closest_point_curve(nrel.lower.iso_curve("v", v), sp.points[sp.lower_data])[1]
+        ref = max(du.max(), dl.max()) / sp.chord
+        assert abs(rep.deviation_two_part - ref) <= 1e-11 * ref
+
+
 def test_parting_lines_lie_on_both_halves(nrel):
     le = nrel.parting_lines["leading_edge"]
     v = np.linspace(0, 1, 11)
