@@ -110,6 +110,10 @@ CUT_TABLE_MIN = 33
 #: The v window searched along each ruling of the table, and its sampling step.
 CUT_SEARCH_WINDOW = (-1.5, 2.5)
 CUT_SEARCH_STEP = 0.1
+#: The part of the window queried first (:func:`_search_cuts`); it holds both cuts of the
+#: shipped presets' rulings for standardisation factors down to about 0.75, and a ruling
+#: whose cuts lie outside it is searched over the whole window.
+CUT_SEARCH_BAND = (-0.35, 1.35)
 #: Wall samples per channel patch for the inside/outside test of the search.
 CUT_WALL_SAMPLES = 256
 #: A table whose cut v jumps by more than this second difference between neighbouring
@@ -301,19 +305,41 @@ class _CutTable:
 
 def _search_cuts(surface: PatchString, channel: MeridionalChannel, U: np.ndarray) -> dict:
     """Hub and shroud cuts (v, s) of the rulings at U, found by sampling (see
-    :func:`_cut_tables`)."""
+    :func:`_cut_tables`).
+
+    The wall side of every sample is a k-d tree query, the cost of the search. The walk
+    only needs the samples from the inside one nearest v = 1/2 out to the first one past
+    each wall, so the samples of CUT_SEARCH_BAND are queried first and the rest of the
+    window only for the rulings whose walk they do not settle (:func:`_band_settles`).
+    The samples not queried are NaN, which the walk below reads as neither inside nor
+    past a wall, and never reaches on a settled ruling: the result is the one of querying
+    the whole window, bit for bit."""
     H, d = _rulings_at(surface, U)
     V = np.arange(CUT_SEARCH_WINDOW[0], CUT_SEARCH_WINDOW[1] + 0.5 * CUT_SEARCH_STEP, CUT_SEARCH_STEP)
-    X = H[:, None, :] + V[None, :, None] * d[:, None, :]
-    zr = np.stack([X[..., 2], np.hypot(X[..., 0], X[..., 1])], axis=-1).reshape(-1, 2)
     search = _wall_search(channel)
-    side, foot = {}, {}
-    for which in ("hub", "shroud"):
-        s_w, C_w, n_w, tree = search[which]
-        _, idx = tree.query(zr)
-        side[which] = np.sum((zr - C_w[idx]) * n_w[idx], axis=1).reshape(U.size, V.size)
-        foot[which] = s_w[idx].reshape(U.size, V.size)
-    inside = (side["hub"] < 0.0) & (side["shroud"] < 0.0)
+    side = {which: np.full((U.size, V.size), np.nan) for which in ("hub", "shroud")}
+    foot = {which: np.full((U.size, V.size), np.nan) for which in ("hub", "shroud")}
+
+    def query(rows, cols):
+        X = H[rows][:, None, :] + V[cols][None, :, None] * d[rows][:, None, :]
+        zr = np.stack([X[..., 2], np.hypot(X[..., 0], X[..., 1])], axis=-1).reshape(-1, 2)
+        block = np.ix_(rows, cols)
+        for which in ("hub", "shroud"):
+            s_w, C_w, n_w, tree = search[which]
+            _, idx = tree.query(zr)
+            side[which][block] = np.sum((zr - C_w[idx]) * n_w[idx], axis=1).reshape(rows.size, cols.size)
+            foot[which][block] = s_w[idx].reshape(rows.size, cols.size)
+
+    key = np.abs(V - 0.5)
+    band = np.nonzero((V >= CUT_SEARCH_BAND[0]) & (V <= CUT_SEARCH_BAND[1]))[0]
+    rows = np.arange(U.size)
+    query(rows, band)
+    rest = np.setdiff1d(np.arange(V.size), band)
+    open_rows = rows[~_band_settles(side, key, band, rest)]
+    if open_rows.size and rest.size:
+        query(open_rows, rest)
+    with np.errstate(invalid="ignore"):
+        inside = (side["hub"] < 0.0) & (side["shroud"] < 0.0)
     missing = ~inside.any(axis=1)
     if missing.any():
         raise CutError(f"the rulings at U = {_u_list(U, missing)} do not pass through the new channel",
@@ -324,12 +350,14 @@ def _search_cuts(surface: PatchString, channel: MeridionalChannel, U: np.ndarray
     out = {}
     for which in ("hub", "shroud"):
         g = side[which]
+        with np.errstate(invalid="ignore"):
+            past = g >= 0.0
         if which == "shroud":
-            hit = (g >= 0.0) & (k > ref[:, None])
+            hit = past & (k > ref[:, None])
             hi = np.argmax(hit, axis=1)
             lo = hi - 1
         else:
-            hit = (g >= 0.0) & (k < ref[:, None])
+            hit = past & (k < ref[:, None])
             lo = V.size - 1 - np.argmax(hit[:, ::-1], axis=1)
             hi = lo + 1
         found = hit.any(axis=1)
@@ -348,6 +376,26 @@ def _search_cuts(surface: PatchString, channel: MeridionalChannel, U: np.ndarray
                            "ill-conditioned (they run nearly along it)", which, U[strayed])
         out[which] = (v, s)
     return out
+
+
+def _band_settles(side: dict, key: np.ndarray, band: np.ndarray, rest: np.ndarray) -> np.ndarray:
+    """Per ruling: whether the samples ``band`` (contiguous columns) settle the walk of
+    :func:`_search_cuts` as the whole window would: the inside sample nearest v = 1/2
+    (smallest ``key``, the first of equals) is in the band and nearer than every sample
+    outside it, and the band holds a sample past the shroud above it and one past the hub
+    below it (the walk stops at the first of those, so the samples beyond are not read)."""
+    with np.errstate(invalid="ignore"):
+        inside = (side["hub"][:, band] < 0.0) & (side["shroud"][:, band] < 0.0)
+        past_hub = side["hub"][:, band] >= 0.0
+        past_shroud = side["shroud"][:, band] >= 0.0
+    nearest_outside = key[rest].min(initial=np.inf)
+    cand = np.argmin(np.where(inside, key[band][None, :], np.inf), axis=1)
+    rows = np.arange(inside.shape[0])
+    ref_ok = inside[rows, cand] & (key[band][cand] < nearest_outside)
+    k = np.arange(band.size)[None, :]
+    shroud_ok = (past_shroud & (k > cand[:, None])).any(axis=1)
+    hub_ok = (past_hub & (k < cand[:, None])).any(axis=1)
+    return ref_ok & shroud_ok & hub_ok
 
 
 def _cut_tables(surface: PatchString, channel: MeridionalChannel) -> dict:
