@@ -30,6 +30,12 @@ ROOT_KEY = "bladesmith_impeller_root"
 PART_KEY = "bladesmith_part"
 #: Blender evaluation points per control point of the displayed surfaces.
 SURFACE_RESOLUTION = 3
+#: Curve data of other net sizes a part has shown, kept per part (object name) for reuse:
+#: a Blender surface net changes size only through edit mode (``make_segment``, three
+#: operator calls that each re-evaluate the view layer), and a panel edit that changes a
+#: blade's patch count (a splitter LE, a tolerance) often goes back to a size shown before.
+SPARE_SIZES = 4
+_SPARES: dict = {}
 
 
 def preset_names() -> list[str]:
@@ -69,6 +75,62 @@ def net_to_mesh(net: np.ndarray, name: str, collection):
     return obj
 
 
+def _net_size(surface) -> tuple[int, int]:
+    """The (u, v) size of the Blender net :func:`write_surface` makes of ``surface``: its
+    Bezier form (p (interior breaks + 1) + 1 points per direction of a clamped knot
+    vector), a single linear segment in v with the midpoint column added."""
+    sizes = []
+    for p, knots in ((surface.degree_u, surface.knots_u), (surface.degree_v, surface.knots_v)):
+        sizes.append(p * (np.unique(knots[p + 1:-p - 1]).size + 1) + 1)
+    return sizes[0], 3 if sizes[1] == 2 else sizes[1]
+
+
+def _net_of(data):
+    splines = data.splines
+    return (splines[0].point_count_u, splines[0].point_count_v) if len(splines) == 1 else None
+
+
+def _reuse_spare(obj, surface) -> None:
+    """Give ``obj`` the spare curve data of the net size ``surface`` needs, if its own has
+    another size and a spare of that size exists (no user, one spline: made by
+    :func:`write_surface` for this part before); its own data becomes a spare. The write
+    that follows then only rewrites points; without a spare it rebuilds the net as before.
+    Linked copies (full wheel) are pointed at the new data by :func:`build_children`."""
+    have, need = _net_of(obj.data), _net_size(surface)
+    if have == need:
+        return
+    spares = _SPARES.setdefault(obj.name, {})
+    name = spares.pop(need, None)
+    data = bpy.data.curves.get(name) if name is not None else None
+    if data is None or data.users != 0 or _net_of(data) != need:
+        return
+    old = obj.data
+    obj.data = data
+    if have is not None:
+        spares[have] = old.name
+    while len(spares) > SPARE_SIZES:
+        oldest = bpy.data.curves.get(spares.pop(next(iter(spares))))
+        if oldest is not None and oldest.users == 0:
+            bpy.data.curves.remove(oldest)
+
+
+def _keep_spare(obj, surface) -> None:
+    """Before ``obj``'s net is rebuilt for ``surface`` (another size, no spare): keep a
+    copy of its current data as the spare of its size."""
+    have = _net_of(obj.data)
+    if have is None or have == _net_size(surface):
+        return
+    spares = _SPARES.setdefault(obj.name, {})
+    if have in spares and bpy.data.curves.get(spares[have]) is not None:
+        return
+    spare = obj.data.copy()
+    spares[have] = spare.name
+    while len(spares) > SPARE_SIZES:
+        oldest = bpy.data.curves.get(spares.pop(next(iter(spares))))
+        if oldest is not None and oldest.users == 0:
+            bpy.data.curves.remove(oldest)
+
+
 def _child(root, name: str, data, collection):
     obj = bpy.data.objects.new(f"{root.name} {name}", data)
     collection.objects.link(obj)
@@ -99,6 +161,8 @@ def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_
             obj[PART_KEY] = name
             obj.parent = root
         else:
+            _reuse_spare(obj, surface)
+            _keep_spare(obj, surface)
             write_surface(obj, surface, SURFACE_RESOLUTION)
         wanted[name] = obj
     count = model.count if full_wheel else 1

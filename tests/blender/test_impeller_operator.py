@@ -388,3 +388,38 @@ def test_unknown_preset_is_refused_by_name(impeller_modules, scene):
     with pytest.raises(RuntimeError, match="unknown preset 'no_such_wheel'"):
         bpy.ops.bladesmith.add_impeller(preset="no_such_wheel")
     assert len(bpy.data.objects) == before
+
+
+def test_panel_splitter_edits_reuse_the_nets_of_sizes_shown_before(impeller_modules, scene, monkeypatch):
+    """A splitter LE edit changes the splitter's patch count, so its nets change size, which
+    Blender allows only through edit mode (make_segment). Going back to a size shown
+    before takes the curve data kept for it: no edit-mode rebuild, and every child still
+    shows the independent build exactly (stored data valid), the linked copies of the full
+    wheel included."""
+    from bladesmith.operators import nurbs_objects
+
+    ops = impeller_modules[0]
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=True)
+    root = bpy.context.active_object
+    s = root.bladesmith_impeller
+    s.splitter = True
+    rebuilds = []
+    editing = nurbs_objects._editing
+    monkeypatch.setattr(nurbs_objects, "_editing", lambda obj: rebuilds.append(obj.name) or editing(obj))
+    sizes = {}
+    for round_ in range(2):
+        for value in (1.6, 1.55):
+            rebuilds.clear()
+            s.splitter_leading_edge_hub = value
+            assert s.status == ""
+            children = {c["bladesmith_part"]: c for c in root.children}
+            _, reference = _standardised_reference(root)
+            for name, surface in reference.items():
+                (shown,) = nurbs_objects.stored_geometry(children[name])
+                assert np.array_equal(shown.control_points, surface.control_points), name
+            first = children["splitter 1 S"]
+            assert all(children[f"splitter {k} S"].data is first.data for k in range(2, s.blade_count + 1))
+            sizes.setdefault(value, set()).add(ops._net_of(first.data))
+            if round_:
+                assert rebuilds == [], rebuilds
+    assert len(sizes[1.6]) == len(sizes[1.55]) == 1 and sizes[1.6] != sizes[1.55]
