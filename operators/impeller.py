@@ -90,12 +90,15 @@ def _net_of(data):
     return (splines[0].point_count_u, splines[0].point_count_v) if len(splines) == 1 else None
 
 
-def _reuse_spare(obj, surface) -> None:
-    """Give ``obj`` the spare curve data of the net size ``surface`` needs, if its own has
-    another size and a spare of that size exists (no user, one spline: made by
-    :func:`write_surface` for this part before); its own data becomes a spare. The write
-    that follows then only rewrites points; without a spare it rebuilds the net as before.
-    Linked copies (full wheel) are pointed at the new data by :func:`build_children`."""
+def _reuse_spare(obj, surface, donors: dict) -> None:
+    """Give ``obj`` curve data whose net has the size ``surface`` needs, when its own has
+    another size: the spare of that size (no user, one spline: made by
+    :func:`write_surface` for this part before), else a copy of ``donors``' data of that
+    size (a part written just before with the same net size: S, P and B of a blade share
+    their patch count); its own data becomes a spare. The write that follows then only
+    rewrites points (the flags and orders of a :func:`write_surface` net are the same for
+    every part); with neither it rebuilds the net as before. Linked copies (full wheel)
+    are pointed at the new data by :func:`build_children`."""
     have, need = _net_of(obj.data), _net_size(surface)
     if have == need:
         return
@@ -103,7 +106,10 @@ def _reuse_spare(obj, surface) -> None:
     name = spares.pop(need, None)
     data = bpy.data.curves.get(name) if name is not None else None
     if data is None or data.users != 0 or _net_of(data) != need:
-        return
+        donor = donors.get(need)
+        if donor is None:
+            return
+        data = donor.copy()
     old = obj.data
     obj.data = data
     if have is not None:
@@ -153,7 +159,7 @@ def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_
     reference = impeller_surfaces(model, 1, include_camber=True)
     existing = {child.get(PART_KEY): child for child in root.children}
     collection = root.users_collection[0]
-    wanted = {}
+    wanted, donors = {}, {}
     for name, surface in reference:
         obj = existing.get(name)
         if obj is None or obj.type != "SURFACE":
@@ -161,9 +167,10 @@ def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_
             obj[PART_KEY] = name
             obj.parent = root
         else:
-            _reuse_spare(obj, surface)
+            _reuse_spare(obj, surface, donors)
             _keep_spare(obj, surface)
             write_surface(obj, surface, SURFACE_RESOLUTION)
+        donors.setdefault(_net_of(obj.data), obj.data)
         wanted[name] = obj
     count = model.count if full_wheel else 1
     for k in range(1, count):
