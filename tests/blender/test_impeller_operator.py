@@ -395,7 +395,8 @@ def test_panel_splitter_edits_reuse_the_nets_of_sizes_shown_before(impeller_modu
     Blender allows only through edit mode (make_segment). Going back to a size shown
     before takes the curve data kept for it: no edit-mode rebuild, and every child still
     shows the independent build exactly (stored data valid), the linked copies of the full
-    wheel included."""
+    wheel included. A part that changes to a size not shown before copies the data of a
+    part just rebuilt to it (S, P and B share the patch count)."""
     from bladesmith.operators import nurbs_objects
 
     ops = impeller_modules[0]
@@ -420,6 +421,6 @@ def test_panel_splitter_edits_reuse_the_nets_of_sizes_shown_before(impeller_modu
             first = children["splitter 1 S"]
             assert all(children[f"splitter {k} S"].data is first.data for k in range(2, s.blade_count + 1))
             sizes.setdefault(value, set()).add(ops._net_of(first.data))
-            if round_:
-                assert rebuilds == [], rebuilds
+            # first round: one net rebuilt, the other parts of that size copy it; then none
+            assert len(rebuilds) <= (0 if round_ else 1), rebuilds
     assert len(sizes[1.6]) == len(sizes[1.55]) == 1 and sizes[1.6] != sizes[1.55]
