@@ -110,10 +110,11 @@ CUT_TABLE_MIN = 33
 #: The v window searched along each ruling of the table, and its sampling step.
 CUT_SEARCH_WINDOW = (-1.5, 2.5)
 CUT_SEARCH_STEP = 0.1
-#: The part of the window queried first (:func:`_search_cuts`); it holds both cuts of the
-#: shipped presets' rulings for standardisation factors down to about 0.75, and a ruling
-#: whose cuts lie outside it is searched over the whole window.
-CUT_SEARCH_BAND = (-0.35, 1.35)
+#: The part of the window queried first (:func:`_search_cuts`): it holds the samples either
+#: side of both cuts of the shipped presets' rulings for standardisation factors from 0.7
+#: to 1.05 (measured; at 1.1 some rulings need more); a ruling it does not settle is
+#: searched over the whole window, so the band sets the cost only, never the result.
+CUT_SEARCH_BAND = (-0.15, 1.15)
 #: Wall samples per channel patch for the inside/outside test of the search.
 CUT_WALL_SAMPLES = 256
 #: A table whose cut v jumps by more than this second difference between neighbouring
