@@ -454,10 +454,22 @@ class StandardisedSurface:
     def _tables(self) -> dict:
         return _cut_tables(self.surface, self.channel)
 
+    def _rulings(self, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`_rulings_at` of the surface, remembering the last parameters: the fit of
+        the trimmed edges asks for the hub and then the shroud cut at the same U (the
+        arrays are only read)."""
+        key = U.tobytes()
+        last = self.__dict__.get("_last_rulings")
+        if last is not None and last[0] == key:
+            return last[1], last[2]
+        H, d = _rulings_at(self.surface, U)
+        self.__dict__["_last_rulings"] = (key, H, d)
+        return H, d
+
     def _cut(self, U, which: str):
         U = np.atleast_1d(np.asarray(U, dtype=float))
         v0, s0 = self._tables[which].start(U)
-        H, d = _rulings_at(self.surface, U)
+        H, d = self._rulings(U)
         v, s = _cut_newton(H, d, self.channel.wall(which), v0, s0, which, U)
         drift = np.abs(v - v0) > CUT_MAX_DRIFT
         if drift.any():
