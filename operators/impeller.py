@@ -28,7 +28,8 @@ from .scene_guard import unchanged_on_refusal
 PRESET_DIR = pathlib.Path(__file__).resolve().parent.parent / "data" / "impellers"
 ROOT_KEY = "bladesmith_impeller_root"
 PART_KEY = "bladesmith_part"
-#: Blender evaluation points per control point of the displayed surfaces.
+#: Blender evaluation points per control point of the displayed surfaces (along a
+#: direction with one linear segment, see :func:`display_resolution`).
 SURFACE_RESOLUTION = 3
 #: Curve data of other net sizes a part has shown, kept per part (object name) for reuse:
 #: a Blender surface net changes size only through edit mode (``make_segment``, three
@@ -73,6 +74,20 @@ def net_to_mesh(net: np.ndarray, name: str, collection):
     obj = bpy.data.objects.new(name, mesh)
     collection.objects.link(obj)
     return obj
+
+
+def display_resolution(surface) -> tuple[int, int]:
+    """Blender's (u, v) resolution for ``surface``: SURFACE_RESOLUTION, but 1 along a
+    direction that is one linear segment (the v of Casey's ruled blade surfaces, S, P,
+    B and the end caps, trimmed or not): Blender then evaluates the two edges only, and
+    the straight rulings between them are the surface's own, so the shape drawn along v
+    is exact; the rows in between only cost evaluation, Z times in a full wheel (the
+    linked copies each tessellate the shared data)."""
+    def one(degree, count):
+        return 1 if degree == 1 and count == 2 else SURFACE_RESOLUTION
+
+    n_u, n_v = surface.control_points.shape[:2]
+    return one(surface.degree_u, n_u), one(surface.degree_v, n_v)
 
 
 def _net_size(surface) -> tuple[int, int]:
@@ -163,13 +178,13 @@ def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_
     for name, surface in reference:
         obj = existing.get(name)
         if obj is None or obj.type != "SURFACE":
-            obj = surface_to_object(surface, f"{root.name} {name}", collection, SURFACE_RESOLUTION)
+            obj = surface_to_object(surface, f"{root.name} {name}", collection, display_resolution(surface))
             obj[PART_KEY] = name
             obj.parent = root
         else:
             _reuse_spare(obj, surface, donors)
             _keep_spare(obj, surface)
-            write_surface(obj, surface, SURFACE_RESOLUTION)
+            write_surface(obj, surface, display_resolution(surface))
         donors.setdefault(_net_of(obj.data), obj.data)
         wanted[name] = obj
     count = model.count if full_wheel else 1

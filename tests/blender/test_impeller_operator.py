@@ -424,3 +424,34 @@ def test_panel_splitter_edits_reuse_the_nets_of_sizes_shown_before(impeller_modu
             # first round: one net rebuilt, the other parts of that size copy it; then none
             assert len(rebuilds) <= (0 if round_ else 1), rebuilds
     assert len(sizes[1.6]) == len(sizes[1.55]) == 1 and sizes[1.6] != sizes[1.55]
+
+
+def test_blades_display_their_rulings_walls_their_arcs(impeller_modules, scene):
+    """Blade parts (one linear segment in v: S, P, B, caps) are evaluated by Blender with
+    resolution 1 along v: three rows of points (v = 0, 1/2, 1 of the net with its midpoint
+    column), on the straight rulings, which are the surface's own; a full wheel's Z linked
+    copies tessellate a third of the rows of resolution 3. Walls keep SURFACE_RESOLUTION
+    both ways."""
+    from bladesmith.operators.nurbs_objects import stored_geometry
+
+    ops = impeller_modules[0]
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False)
+    root = bpy.context.active_object
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    for child in root.children:
+        if child.type != "SURFACE":
+            continue
+        spline = child.data.splines[0]
+        part = child["bladesmith_part"]
+        if part.startswith(("hub", "shroud")):
+            assert (spline.resolution_u, spline.resolution_v) == (ops.SURFACE_RESOLUTION,) * 2, part
+            continue
+        assert (spline.resolution_u, spline.resolution_v) == (ops.SURFACE_RESOLUTION, 1), part
+        (surface,) = stored_geometry(child)
+        u = np.linspace(*surface.knots_u[[0, -1]], 4001)
+        edges = [surface.evaluate(u, np.full_like(u, v)) for v in (0.0, 0.5, 1.0)]
+        mesh = child.evaluated_get(depsgraph).to_mesh()
+        X = np.array([v.co[:] for v in mesh.vertices])
+        child.evaluated_get(depsgraph).to_mesh_clear()
+        near = np.min([np.min(np.linalg.norm(X[:, None] - E[None, ::8], axis=-1), axis=1) for E in edges], axis=0)
+        assert near.max() < 1e-3, part  # every drawn point on one of the rows (to the sample spacing)
