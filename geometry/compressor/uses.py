@@ -310,35 +310,49 @@ def _search_cuts(surface: PatchString, channel: MeridionalChannel, U: np.ndarray
 
     The wall side of every sample is a k-d tree query, the cost of the search. The walk
     only needs the samples from the inside one nearest v = 1/2 out to the first one past
-    each wall, so the samples of CUT_SEARCH_BAND are queried first and the rest of the
-    window only for the rulings whose walk they do not settle (:func:`_band_settles`).
-    The samples not queried are NaN, which the walk below reads as neither inside nor
-    past a wall, and never reaches on a settled ruling: the result is the one of querying
-    the whole window, bit for bit."""
+    each wall, so that is what is queried first: both walls at that sample (the ruling's
+    middle, which is inside for any channel the rulings cross properly), the hub below it
+    and the shroud above it within CUT_SEARCH_BAND; the whole window only for the rulings
+    this does not settle (the middle outside, or no sample past a wall in the band). The
+    samples not queried are NaN, which the walk below reads as neither inside nor past a
+    wall, and never reaches on a settled ruling: the result is the one of querying the
+    whole window, bit for bit."""
     H, d = _rulings_at(surface, U)
     V = np.arange(CUT_SEARCH_WINDOW[0], CUT_SEARCH_WINDOW[1] + 0.5 * CUT_SEARCH_STEP, CUT_SEARCH_STEP)
     search = _wall_search(channel)
     side = {which: np.full((U.size, V.size), np.nan) for which in ("hub", "shroud")}
     foot = {which: np.full((U.size, V.size), np.nan) for which in ("hub", "shroud")}
 
-    def query(rows, cols):
+    def query(rows, cols, walls=("hub", "shroud")):
+        if rows.size == 0 or cols.size == 0:
+            return
         X = H[rows][:, None, :] + V[cols][None, :, None] * d[rows][:, None, :]
         zr = np.stack([X[..., 2], np.hypot(X[..., 0], X[..., 1])], axis=-1).reshape(-1, 2)
         block = np.ix_(rows, cols)
-        for which in ("hub", "shroud"):
+        for which in walls:
             s_w, C_w, n_w, tree = search[which]
             _, idx = tree.query(zr)
             side[which][block] = np.sum((zr - C_w[idx]) * n_w[idx], axis=1).reshape(rows.size, cols.size)
             foot[which][block] = s_w[idx].reshape(rows.size, cols.size)
 
     key = np.abs(V - 0.5)
+    middle = int(np.argmin(key))
     band = np.nonzero((V >= CUT_SEARCH_BAND[0]) & (V <= CUT_SEARCH_BAND[1]))[0]
     rows = np.arange(U.size)
-    query(rows, band)
-    rest = np.setdiff1d(np.arange(V.size), band)
-    open_rows = rows[~_band_settles(side, key, band, rest)]
-    if open_rows.size and rest.size:
-        query(open_rows, rest)
+    settled = np.zeros(U.size, dtype=bool)
+    # the walk starts at the middle sample whenever it is inside: its key is the only
+    # smallest one (else no shortcut), and the band is contiguous through it
+    if np.count_nonzero(key == key[middle]) == 1 and middle in band and np.all(np.diff(band) == 1):
+        below, above = band[band < middle], band[band > middle]
+        query(rows, np.array([middle]))
+        with np.errstate(invalid="ignore"):
+            started = rows[(side["hub"][:, middle] < 0.0) & (side["shroud"][:, middle] < 0.0)]
+        query(started, below, ("hub",))
+        query(started, above, ("shroud",))
+        with np.errstate(invalid="ignore"):
+            settled[started] = ((side["hub"][np.ix_(started, below)] >= 0.0).any(axis=1)
+                                & (side["shroud"][np.ix_(started, above)] >= 0.0).any(axis=1))
+    query(rows[~settled], np.arange(V.size))
     with np.errstate(invalid="ignore"):
         inside = (side["hub"] < 0.0) & (side["shroud"] < 0.0)
     missing = ~inside.any(axis=1)
@@ -377,26 +391,6 @@ def _search_cuts(surface: PatchString, channel: MeridionalChannel, U: np.ndarray
                            "ill-conditioned (they run nearly along it)", which, U[strayed])
         out[which] = (v, s)
     return out
-
-
-def _band_settles(side: dict, key: np.ndarray, band: np.ndarray, rest: np.ndarray) -> np.ndarray:
-    """Per ruling: whether the samples ``band`` (contiguous columns) settle the walk of
-    :func:`_search_cuts` as the whole window would: the inside sample nearest v = 1/2
-    (smallest ``key``, the first of equals) is in the band and nearer than every sample
-    outside it, and the band holds a sample past the shroud above it and one past the hub
-    below it (the walk stops at the first of those, so the samples beyond are not read)."""
-    with np.errstate(invalid="ignore"):
-        inside = (side["hub"][:, band] < 0.0) & (side["shroud"][:, band] < 0.0)
-        past_hub = side["hub"][:, band] >= 0.0
-        past_shroud = side["shroud"][:, band] >= 0.0
-    nearest_outside = key[rest].min(initial=np.inf)
-    cand = np.argmin(np.where(inside, key[band][None, :], np.inf), axis=1)
-    rows = np.arange(inside.shape[0])
-    ref_ok = inside[rows, cand] & (key[band][cand] < nearest_outside)
-    k = np.arange(band.size)[None, :]
-    shroud_ok = (past_shroud & (k > cand[:, None])).any(axis=1)
-    hub_ok = (past_hub & (k < cand[:, None])).any(axis=1)
-    return ref_ok & shroud_ok & hub_ok
 
 
 def _cut_tables(surface: PatchString, channel: MeridionalChannel) -> dict:

@@ -248,16 +248,18 @@ def test_standardising_a_preset_is_fast():
 @pytest.mark.parametrize("factors", [(0.8, 1.0), (0.4, 1.0), (1.0, 0.5), (1.45, 1.0), (1.0, 1.45), (0.9, 1.2)],
                          ids=lambda f: f"s{f[0]}-h{f[1]}")
 def test_banded_cut_search_is_the_whole_window_search(monkeypatch, factors):
-    """The cut search queries CUT_SEARCH_BAND first and the rest of the window only for
-    rulings the band does not settle (issue 18, panel-edit speed): its (v, s) starts, and
-    its refusals, are those of querying the whole window, bit for bit, for cuts inside
-    the band, beyond it (factors 0.4 and 1.45) and refused ones."""
+    """The cut search queries the middle sample of each ruling, the hub below it and the
+    shroud above it within CUT_SEARCH_BAND first, and the whole window only for rulings
+    that does not settle (issue 18, panel-edit speed): its (v, s) starts, and its
+    refusals, are those of querying the whole window, bit for bit, for cuts inside the
+    band, beyond it (factors 0.4 and 1.45) and refused ones."""
     from bladesmith.geometry.compressor import uses
 
     master = definition("high_flow").build()
     channel = scaled_channel(master.channel, *factors)
     results = {}
-    for label, band in (("banded", uses.CUT_SEARCH_BAND), ("whole", uses.CUT_SEARCH_WINDOW)):
+    # an empty band: no shortcut, every ruling queried over the whole window
+    for label, band in (("banded", uses.CUT_SEARCH_BAND), ("whole", (9.0, 9.0))):
         monkeypatch.setattr(uses, "CUT_SEARCH_BAND", band)
         found = []
         for surface in (master.blade.suction, master.blade.pressure, master.blade.camber):
