@@ -183,7 +183,7 @@ class WallCamber:
         U = np.asarray(U, dtype=float)
         # beyond the TE (rounded caps) integrate from the last edge itself: the interval
         # before it may end at a channel junction, where |M'(U)| jumps
-        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 1)
+        k = np.minimum(np.maximum(np.searchsorted(self._edges, U, side="right") - 1, 0), len(self._edges) - 1)
         a = self._edges[k]
         half = 0.5 * (U - a)
         return k, half, a[..., None] + half[..., None] * (_GL_X + 1.0)
@@ -197,7 +197,7 @@ class WallCamber:
         U = np.asarray(U, dtype=float)
         # beyond the TE (rounded caps) integrate from the last edge itself: the interval
         # before it may end at a channel junction, where |M'(U)| jumps
-        k = np.clip(np.searchsorted(self._edges, U, side="right") - 1, 0, len(self._edges) - 1)
+        k = np.minimum(np.maximum(np.searchsorted(self._edges, U, side="right") - 1, 0), len(self._edges) - 1)
         a = self._edges[k]
         half = 0.5 * (U - a)
         nodes = a[..., None] + half[..., None] * (_GL_X + 1.0)
