@@ -92,6 +92,18 @@ def classify_free_edges(cfd, sewing, units: float = 1000.0) -> dict:
     return counts
 
 
+def shells(sewing) -> int:
+    """Shells in the sewn shape: 1 when the faces sewed into one connected shell."""
+    from OCP.TopAbs import TopAbs_SHELL
+    from OCP.TopExp import TopExp_Explorer
+
+    count, explorer = 0, TopExp_Explorer(sewing.SewedShape(), TopAbs_SHELL)
+    while explorer.More():
+        count += 1
+        explorer.Next()
+    return count
+
+
 def written(tmp_path, name, full_wheel):
     model = ImpellerDefinition.from_toml(PRESETS / f"{name}.toml").build()
     cfd = cfd_set(model, full_wheel=full_wheel)
@@ -131,15 +143,17 @@ def test_single_passage_sews_closed_but_inlet_outlet_and_periodic_sides(tmp_path
     # side of the sector (3 pieces per side: upstream line, blade-following curve, downstream)
     assert classify_free_edges(cfd, sewing) == {"inlet (hub)": 1, "inlet (shroud)": 1, "outlet (hub)": 1,
                                                 "outlet (shroud)": 1, "side (hub)": 6, "side (shroud)": 6}
-    assert sewing.NbMultipleEdges() == 0
+    assert sewing.NbMultipleEdges() == 0 and shells(sewing) == 1
 
 
-def test_full_wheel_sews_closed_but_inlet_and_outlet(tmp_path):
-    model, cfd, path = written(tmp_path, "high_flow", True)
+@pytest.mark.parametrize("name", ["high_flow", "intermediate_flow", "low_flow", "return_channel"])
+def test_full_wheel_sews_closed_but_inlet_and_outlet(tmp_path, name):
+    model, cfd, path = written(tmp_path, name, True)
     res = read_with_occ(path)
     assert res.load_messages == [] and res.transfer_messages == []
-    assert len(res.faces) == model.count * (2 + 4)
+    assert len(res.faces) == model.count * (2 + 4 * (1 + (model.splitter is not None)))
     sewing, mids = sew(res.faces, SEWING_FRACTION * cfd.diameter * 1000.0)
+    assert shells(sewing) == 1
     assert len(mids) == 4 * model.count and on_inlet_or_outlet(model, mids).all()
     Z = model.count
     assert classify_free_edges(cfd, sewing) == {"inlet (hub)": Z, "inlet (shroud)": Z, "outlet (hub)": Z,
