@@ -201,3 +201,5 @@ def test_standardised_passage_sews_closed_but_inlet_outlet_and_periodic_sides(tm
     sewing, mids = sew(res.faces, SEWING_FRACTION * cfd.diameter * 1000.0)
     ends = on_inlet_or_outlet(model, mids)
     assert ends.sum() == 4 and (~ends).sum() == 12, mids
+    assert classify_free_edges(cfd, sewing) == {"inlet (hub)": 1, "inlet (shroud)": 1, "outlet (hub)": 1,
+                                                "outlet (shroud)": 1, "side (hub)": 6, "side (shroud)": 6}
