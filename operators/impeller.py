@@ -28,8 +28,15 @@ from .scene_guard import unchanged_on_refusal
 PRESET_DIR = pathlib.Path(__file__).resolve().parent.parent / "data" / "impellers"
 ROOT_KEY = "bladesmith_impeller_root"
 PART_KEY = "bladesmith_part"
-#: Blender evaluation points per control point of the displayed surfaces.
+#: Blender evaluation points per control point of the displayed surfaces (along a
+#: direction with one linear segment, see :func:`display_resolution`).
 SURFACE_RESOLUTION = 3
+#: Curve data of other net sizes a part has shown, kept per part (object name) for reuse:
+#: a Blender surface net changes size only through edit mode (``make_segment``, three
+#: operator calls that each re-evaluate the view layer), and a panel edit that changes a
+#: blade's patch count (a splitter LE, a tolerance) often goes back to a size shown before.
+SPARE_SIZES = 4
+_SPARES: dict = {}
 
 
 def preset_names() -> list[str]:
@@ -69,6 +76,82 @@ def net_to_mesh(net: np.ndarray, name: str, collection):
     return obj
 
 
+def display_resolution(surface) -> tuple[int, int]:
+    """Blender's (u, v) resolution for ``surface``: SURFACE_RESOLUTION, but 1 along a
+    direction that is one linear segment (the v of Casey's ruled blade surfaces, S, P,
+    B and the end caps, trimmed or not): Blender then evaluates the two edges only, and
+    the straight rulings between them are the surface's own, so the shape drawn along v
+    is exact; the rows in between only cost evaluation, Z times in a full wheel (the
+    linked copies each tessellate the shared data)."""
+    def one(degree, count):
+        return 1 if degree == 1 and count == 2 else SURFACE_RESOLUTION
+
+    n_u, n_v = surface.control_points.shape[:2]
+    return one(surface.degree_u, n_u), one(surface.degree_v, n_v)
+
+
+def _net_size(surface) -> tuple[int, int]:
+    """The (u, v) size of the Blender net :func:`write_surface` makes of ``surface``: its
+    Bezier form (p (interior breaks + 1) + 1 points per direction of a clamped knot
+    vector), a single linear segment in v with the midpoint column added."""
+    sizes = []
+    for p, knots in ((surface.degree_u, surface.knots_u), (surface.degree_v, surface.knots_v)):
+        sizes.append(p * (np.unique(knots[p + 1:-p - 1]).size + 1) + 1)
+    return sizes[0], 3 if sizes[1] == 2 else sizes[1]
+
+
+def _net_of(data):
+    splines = data.splines
+    return (splines[0].point_count_u, splines[0].point_count_v) if len(splines) == 1 else None
+
+
+def _reuse_spare(obj, surface, donors: dict) -> None:
+    """Give ``obj`` curve data whose net has the size ``surface`` needs, when its own has
+    another size: the spare of that size (no user, one spline: made by
+    :func:`write_surface` for this part before), else a copy of ``donors``' data of that
+    size (a part written just before with the same net size: S, P and B of a blade share
+    their patch count); its own data becomes a spare. The write that follows then only
+    rewrites points (the flags and orders of a :func:`write_surface` net are the same for
+    every part); with neither it rebuilds the net as before. Linked copies (full wheel)
+    are pointed at the new data by :func:`build_children`."""
+    have, need = _net_of(obj.data), _net_size(surface)
+    if have == need:
+        return
+    spares = _SPARES.setdefault(obj.name, {})
+    name = spares.pop(need, None)
+    data = bpy.data.curves.get(name) if name is not None else None
+    if data is None or data.users != 0 or _net_of(data) != need:
+        donor = donors.get(need)
+        if donor is None:
+            return
+        data = donor.copy()
+    old = obj.data
+    obj.data = data
+    if have is not None:
+        spares[have] = old.name
+    while len(spares) > SPARE_SIZES:
+        oldest = bpy.data.curves.get(spares.pop(next(iter(spares))))
+        if oldest is not None and oldest.users == 0:
+            bpy.data.curves.remove(oldest)
+
+
+def _keep_spare(obj, surface) -> None:
+    """Before ``obj``'s net is rebuilt for ``surface`` (another size, no spare): keep a
+    copy of its current data as the spare of its size."""
+    have = _net_of(obj.data)
+    if have is None or have == _net_size(surface):
+        return
+    spares = _SPARES.setdefault(obj.name, {})
+    if have in spares and bpy.data.curves.get(spares[have]) is not None:
+        return
+    spare = obj.data.copy()
+    spares[have] = spare.name
+    while len(spares) > SPARE_SIZES:
+        oldest = bpy.data.curves.get(spares.pop(next(iter(spares))))
+        if oldest is not None and oldest.users == 0:
+            bpy.data.curves.remove(oldest)
+
+
 def _child(root, name: str, data, collection):
     obj = bpy.data.objects.new(f"{root.name} {name}", data)
     collection.objects.link(obj)
@@ -91,15 +174,18 @@ def build_children(root, definition: ImpellerDefinition, full_wheel: bool, show_
     reference = impeller_surfaces(model, 1, include_camber=True)
     existing = {child.get(PART_KEY): child for child in root.children}
     collection = root.users_collection[0]
-    wanted = {}
+    wanted, donors = {}, {}
     for name, surface in reference:
         obj = existing.get(name)
         if obj is None or obj.type != "SURFACE":
-            obj = surface_to_object(surface, f"{root.name} {name}", collection, SURFACE_RESOLUTION)
+            obj = surface_to_object(surface, f"{root.name} {name}", collection, display_resolution(surface))
             obj[PART_KEY] = name
             obj.parent = root
         else:
-            write_surface(obj, surface, SURFACE_RESOLUTION)
+            _reuse_spare(obj, surface, donors)
+            _keep_spare(obj, surface)
+            write_surface(obj, surface, display_resolution(surface))
+        donors.setdefault(_net_of(obj.data), obj.data)
         wanted[name] = obj
     count = model.count if full_wheel else 1
     for k in range(1, count):

@@ -388,3 +388,70 @@ def test_unknown_preset_is_refused_by_name(impeller_modules, scene):
     with pytest.raises(RuntimeError, match="unknown preset 'no_such_wheel'"):
         bpy.ops.bladesmith.add_impeller(preset="no_such_wheel")
     assert len(bpy.data.objects) == before
+
+
+def test_panel_splitter_edits_reuse_the_nets_of_sizes_shown_before(impeller_modules, scene, monkeypatch):
+    """A splitter LE edit changes the splitter's patch count, so its nets change size, which
+    Blender allows only through edit mode (make_segment). Going back to a size shown
+    before takes the curve data kept for it: no edit-mode rebuild, and every child still
+    shows the independent build exactly (stored data valid), the linked copies of the full
+    wheel included. A part that changes to a size not shown before copies the data of a
+    part just rebuilt to it (S, P and B share the patch count)."""
+    from bladesmith.operators import nurbs_objects
+
+    ops = impeller_modules[0]
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=True)
+    root = bpy.context.active_object
+    s = root.bladesmith_impeller
+    s.splitter = True
+    rebuilds = []
+    editing = nurbs_objects._editing
+    monkeypatch.setattr(nurbs_objects, "_editing", lambda obj: rebuilds.append(obj.name) or editing(obj))
+    sizes = {}
+    for round_ in range(2):
+        for value in (1.6, 1.55):
+            rebuilds.clear()
+            s.splitter_leading_edge_hub = value
+            assert s.status == ""
+            children = {c["bladesmith_part"]: c for c in root.children}
+            _, reference = _standardised_reference(root)
+            for name, surface in reference.items():
+                (shown,) = nurbs_objects.stored_geometry(children[name])
+                assert np.array_equal(shown.control_points, surface.control_points), name
+            first = children["splitter 1 S"]
+            assert all(children[f"splitter {k} S"].data is first.data for k in range(2, s.blade_count + 1))
+            sizes.setdefault(value, set()).add(ops._net_of(first.data))
+            # first round: one net rebuilt, the other parts of that size copy it; then none
+            assert len(rebuilds) <= (0 if round_ else 1), rebuilds
+    assert len(sizes[1.6]) == len(sizes[1.55]) == 1 and sizes[1.6] != sizes[1.55]
+
+
+def test_blades_display_their_rulings_walls_their_arcs(impeller_modules, scene):
+    """Blade parts (one linear segment in v: S, P, B, caps) are evaluated by Blender with
+    resolution 1 along v: three rows of points (v = 0, 1/2, 1 of the net with its midpoint
+    column), on the straight rulings, which are the surface's own; a full wheel's Z linked
+    copies tessellate a third of the rows of resolution 3. Walls keep SURFACE_RESOLUTION
+    both ways."""
+    from bladesmith.operators.nurbs_objects import stored_geometry
+
+    ops = impeller_modules[0]
+    bpy.ops.bladesmith.add_impeller(preset="high_flow", full_wheel=False)
+    root = bpy.context.active_object
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    for child in root.children:
+        if child.type != "SURFACE":
+            continue
+        spline = child.data.splines[0]
+        part = child["bladesmith_part"]
+        if part.startswith(("hub", "shroud")):
+            assert (spline.resolution_u, spline.resolution_v) == (ops.SURFACE_RESOLUTION,) * 2, part
+            continue
+        assert (spline.resolution_u, spline.resolution_v) == (ops.SURFACE_RESOLUTION, 1), part
+        (surface,) = stored_geometry(child)
+        u = np.linspace(*surface.knots_u[[0, -1]], 4001)
+        edges = [surface.evaluate(u, np.full_like(u, v)) for v in (0.0, 0.5, 1.0)]
+        mesh = child.evaluated_get(depsgraph).to_mesh()
+        X = np.array([v.co[:] for v in mesh.vertices])
+        child.evaluated_get(depsgraph).to_mesh_clear()
+        near = np.min([np.min(np.linalg.norm(X[:, None] - E[None, ::8], axis=-1), axis=1) for E in edges], axis=0)
+        assert near.max() < 1e-3, part  # every drawn point on one of the rows (to the sample spacing)

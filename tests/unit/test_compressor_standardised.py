@@ -243,3 +243,35 @@ def test_standardising_a_preset_is_fast():
         impeller_surfaces(d.build())
         times.append(time.perf_counter() - t)
     assert min(times) < 2.0
+
+
+@pytest.mark.parametrize("factors", [(0.8, 1.0), (0.4, 1.0), (1.0, 0.5), (1.45, 1.0), (1.0, 1.45), (0.9, 1.2)],
+                         ids=lambda f: f"s{f[0]}-h{f[1]}")
+def test_banded_cut_search_is_the_whole_window_search(monkeypatch, factors):
+    """The cut search queries the middle sample of each ruling, the hub below it and the
+    shroud above it within CUT_SEARCH_BAND first, and the whole window only for rulings
+    that does not settle (issue 18, panel-edit speed): its (v, s) starts, and its
+    refusals, are those of querying the whole window, bit for bit, for cuts inside the
+    band, beyond it (factors 0.4 and 1.45) and refused ones."""
+    from bladesmith.geometry.compressor import uses
+
+    master = definition("high_flow").build()
+    channel = scaled_channel(master.channel, *factors)
+    results = {}
+    # an empty band: no shortcut, every ruling queried over the whole window
+    for label, band in (("banded", uses.CUT_SEARCH_BAND), ("whole", (9.0, 9.0))):
+        monkeypatch.setattr(uses, "CUT_SEARCH_BAND", band)
+        found = []
+        for surface in (master.blade.suction, master.blade.pressure, master.blade.camber):
+            U = np.linspace(0.0, surface.count, uses.CUT_SEARCH_PER_PATCH * surface.count + 1)
+            try:
+                cuts = uses._search_cuts(surface, channel, U)
+                found.append([cuts[w][i] for w in ("hub", "shroud") for i in (0, 1)])
+            except CutError as exc:
+                found.append(str(exc))
+        results[label] = found
+    for banded, whole in zip(results["banded"], results["whole"]):
+        if isinstance(whole, str):
+            assert banded == whole
+        else:
+            assert all(np.array_equal(a, b) for a, b in zip(banded, whole))
