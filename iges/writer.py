@@ -365,32 +365,30 @@ _LINE = 81
 _SPACE, _NEWLINE, _LETTER_P = 32, 10, ord("P")
 
 
-def _placement_tables():
-    """Where the characters of a bulk real go, relative to the first character after its
-    sign, by decimal exponent X = -4..16 (row X + 4) and number of kept digits k = 1..17:
-    DIGIT_OFFSETS[(X + 4) · 18 + k, j] for digit j (X >= 0: j + (j > X), the point after
-    digit X; X < 0: 1 - X + j, after "0." and -X - 1 zeros), and the at most five other
-    characters (the point; or "0", the point and the zeros) EXTRA_OFFSETS[X + 4] with
-    their bytes EXTRA_BYTES[X + 4]. Unused entries (dropped digits, unused extra slots)
-    hold -1: they are sent to a scratch area past the block."""
+def _digit_offsets() -> np.ndarray:
+    """Where the digits of a bulk real go, relative to the first character after its
+    sign, by decimal exponent X = -4..16 and number of kept digits k = 1..17: row
+    (X + 4) · 18 + k, column j (X >= 0: j + (j > X), the point after digit X; X < 0:
+    1 - X + j, after "0." and -X - 1 zeros). Dropped digits hold -1."""
     J = np.arange(17)
-    digits = np.full((21 * 18, 17), -1, dtype=np.int64)
-    extra = np.full((21, 5), -1, dtype=np.int64)
-    extra_bytes = np.full((21, 5), _SPACE, dtype=np.uint8)
+    table = np.full((21 * 18, 17), -1, dtype=np.int64)
     for X in range(-4, 17):
         off = J + (J > X) if X >= 0 else 1 - X + J
         for k in range(1, 18):
-            digits[(X + 4) * 18 + k, :k] = off[:k]
-        if X >= 0:
-            extra[X + 4, 0], extra_bytes[X + 4, 0] = X + 1, _DOT
-        else:
-            n = 1 - X  # "0." and -X - 1 zeros
-            extra[X + 4, :n] = np.arange(n)
-            extra_bytes[X + 4, :n] = np.frombuffer(b"0." + b"0" * (n - 2), dtype=np.uint8)
-    return digits, extra, extra_bytes
+            table[(X + 4) * 18 + k, :k] = off[:k]
+    return table
 
 
-_DIGIT_OFFSETS, _EXTRA_OFFSETS, _EXTRA_BYTES = _placement_tables()
+_DIGIT_OFFSETS = _digit_offsets()
+
+
+def _windows(buffer: np.ndarray, width: int) -> np.ndarray:
+    """Every run of ``width`` bytes of ``buffer`` as a row (overlapping rows of a strided
+    view): ``_windows(b, w)[starts] = rows`` writes each row at its start in one call,
+    deterministic as long as the runs written by one call do not overlap."""
+    return np.lib.stride_tricks.as_strided(buffer, shape=(buffer.size - width + 1, width), strides=(1, 1))
+
+
 #: "P" and the sequence number's last 3 + 4 digits: the characters of columns 73-80.
 _P_WORD = np.uint32(ord("P"))
 
@@ -440,7 +438,26 @@ def _place_text(out: np.ndarray, text: bytes, lengths: np.ndarray, pos: np.ndarr
     out[pos[token] + (np.arange(len(text)) - starts[token])] = np.frombuffer(text, dtype=np.uint8)
 
 
-def _bulk_lines(head: str, a: np.ndarray, tail: str, seq: int, pseq: int) -> tuple[str, int]:
+def _orbit(step: np.ndarray, n: int) -> np.ndarray:
+    """0, f(0), f(f(0)), ... up to and including n, for f = ``step`` on 0..n-1 (f(i) > i,
+    increasing) and f(n) = n: the line starts of greedy filling. By repeated squaring
+    (f, f², f⁴, ... until f^(2^K)(0) = n) and expansion from the coarsest level down,
+    each level one array operation instead of one Python step per line."""
+    levels = [np.append(step, n)]
+    while levels[-1][0] != n:
+        f = levels[-1]
+        levels.append(f[f])
+    A = np.zeros(1, dtype=np.int64)
+    for f in reversed(levels[:-1]):  # A = f^0 .. f^(2^k - 1) of 0, doubled each level
+        B = np.empty(2 * A.size, dtype=np.int64)
+        B[0::2] = A
+        B[1::2] = f[A]
+        A = B
+    A = np.append(A, n)
+    return A[: int(np.searchsorted(A, n)) + 1]
+
+
+def _bulk_lines(head: str, a: np.ndarray, tail: str, seq: int, pseq: int) -> tuple[bytes, int]:
     """The P lines of ``head + _reals(a) + "," + tail`` (``a`` with more than
     SHORTEST_REPR_SIZE values, not all equal), byte for byte what ``_pack`` and the line
     format give, built by array arithmetic instead of per-token and per-line strings.
@@ -473,12 +490,7 @@ def _bulk_lines(head: str, a: np.ndarray, tail: str, seq: int, pseq: int) -> tup
     reach = np.searchsorted(cum, cum[:-1] + PD_COLUMNS, side="right") - 1
     if np.any(reach <= np.arange(lengths.size)):
         raise IgesError(f"a parameter is longer than {PD_COLUMNS} columns")
-    nxt = reach.tolist()
-    starts, i, n = [0], 0, lengths.size
-    while i < n:
-        i = nxt[i]
-        starts.append(i)
-    starts = np.array(starts)
+    starts = _orbit(reach, lengths.size)
     L = starts.size - 1
     per_line = np.diff(starts)
     pos = np.repeat(np.arange(L) * _LINE - cum[starts[:-1]], per_line) + cum[:-1]
@@ -494,14 +506,30 @@ def _bulk_lines(head: str, a: np.ndarray, tail: str, seq: int, pseq: int) -> tup
     p = pos_a[ib] + neg  # where the digits (or the "0." before them) start
     out[p[neg == 1] - 1] = _MINUS
     out[pos_a[ib] + lengths[h + ib] - 1] = _COMMA
-    # unused table entries (-1) land in a scratch area as long as the block, past its end,
-    # which is never read
-    row = e + 4
-    far = scratch + 1 + 32
-    digits = np.where(_DIGIT_OFFSETS < 0, far, _DIGIT_OFFSETS)
-    extra = np.where(_EXTRA_OFFSETS < 0, far, _EXTRA_OFFSETS)
-    out[p[:, None] + np.take(digits, row * 18 + kept, axis=0)] = words.view(np.uint8)[:, 3:]
-    out[p[:, None] + np.take(extra, row, axis=0)] = np.take(_EXTRA_BYTES, row, axis=0)
+    digits = words.view(np.uint8)[:, 3:]  # (n, 17)
+    # all 17 digits kept (the usual case): the digits are one run of 17 bytes (X < 0), or
+    # two runs round the point (X >= 0: all 17 one place on, then the integer part over
+    # them, then the point); the runs of one call never overlap (each token is longer)
+    full = kept == 17
+    whole = np.flatnonzero(full & (e < 0))
+    _windows(out, 17)[p[whole] + 1 - e[whole]] = digits[whole]
+    split_ = np.flatnonzero(full & (e >= 0))
+    _windows(out, 17)[p[split_] + 1] = digits[split_]
+    for x in np.unique(e[split_]).tolist():
+        g = split_[e[split_] == x]
+        _windows(out, x + 1)[p[g]] = digits[g, : x + 1]
+    # trailing zeros dropped: digit by digit, the dropped ones sent to a scratch area as
+    # long as the block, past its end, which is never read
+    rest = np.flatnonzero(~full)
+    if rest.size:
+        table = np.where(_DIGIT_OFFSETS < 0, scratch + 1 + 32, _DIGIT_OFFSETS)
+        out[p[rest, None] + np.take(table, (e[rest] + 4) * 18 + kept[rest], axis=0)] = digits[rest]
+    positional = np.flatnonzero(e >= 0)
+    out[p[positional] + e[positional] + 1] = _DOT
+    for x in (-1, -2, -3, -4):  # "0." and -X - 1 zeros before the digits
+        g = np.flatnonzero(e == x)
+        if g.size:
+            _windows(out, 1 - x)[p[g]] = np.frombuffer(b"0." + b"0" * (-x - 1), dtype=np.uint8)
     block = out[:scratch].reshape(L, _LINE)
     block[:, PD_COLUMNS + 1 : PD_COLUMNS + 8] = np.frombuffer(b"%7d" % seq, dtype=np.uint8)
     high, low = np.divmod(np.arange(pseq, pseq + L), 10**4)  # the sequence number < 10**7
@@ -510,7 +538,7 @@ def _bulk_lines(head: str, a: np.ndarray, tail: str, seq: int, pseq: int) -> tup
     tail_words[:, 1] = np.take(_FOUR_DIGITS, low)
     block[:, PD_COLUMNS + 8 : PD_COLUMNS + 16] = tail_words.view(np.uint8)
     block[:, _LINE - 1] = _NEWLINE
-    return out[: scratch - 1].tobytes().decode("ascii"), L
+    return out[: scratch - 1].tobytes(), L
 
 
 #: Greedy line filling: the longest run of at most PD_COLUMNS characters ending in a delimiter.
@@ -664,10 +692,20 @@ def _global_lines(h: GlobalSection) -> list[str]:
 
 
 # -- the file -----------------------------------------------------------------------------------
-def to_string(entities, *, units: str = "m", resolution: float | None = None, header: GlobalSection | None = None,
-              start: str | None = None, file_name: str = "", author: str = "", organization: str = "",
-              timestamp: _dt.datetime | None = None) -> str:
+def to_string(entities, **options) -> str:
     """The IGES file for ``entities`` (records, or an :class:`IgesModel` read before) as text.
+
+    Options: units, resolution, header, start, file_name, author, organization, timestamp
+    (:func:`to_bytes`).
+    """
+    return to_bytes(entities, **options).decode("ascii")
+
+
+def to_bytes(entities, *, units: str = "m", resolution: float | None = None, header: GlobalSection | None = None,
+             start: str | None = None, file_name: str = "", author: str = "", organization: str = "",
+             timestamp: _dt.datetime | None = None) -> bytes:
+    """The IGES file for ``entities`` (records, or an :class:`IgesModel` read before) as
+    ASCII bytes (what :func:`write_iges` writes; :func:`to_string` decodes them).
 
     Entities that the given ones reference are written too. ``header`` (a
     :class:`GlobalSection`) overrides units/resolution/author/...; a model read from a file
@@ -746,7 +784,8 @@ def to_string(entities, *, units: str = "m", resolution: float | None = None, he
             n_lines = len(chunks)
             # one C-level format for all lines of the entity: "%-64s" data, back-pointer, sequence
             fmt = ("%%-64s %7dP%%07d" % seq,) * n_lines
-            p_out.append("\n".join(fmt) % tuple(chain.from_iterable(zip(chunks, range(pseq, pseq + n_lines)))))
+            text = "\n".join(fmt) % tuple(chain.from_iterable(zip(chunks, range(pseq, pseq + n_lines))))
+            p_out.append(text.encode("ascii"))
         t = e.type_number
         tr = de[id(e.transform)] if e.transform is not None else 0
         status = _status(e, referenced, param)
@@ -757,11 +796,8 @@ def to_string(entities, *, units: str = "m", resolution: float | None = None, he
     if pseq - 1 > 9_999_999:
         raise IgesError("too many parameter lines for 7-digit sequence numbers")
     out += d_out
-    out += p_out
     term = f"S{len(s_lines):7d}G{len(g_lines):7d}D{len(d_out):7d}P{pseq - 1:7d}"
-    out.append(f"{term:<72}T{1:07d}")
-    out.append("")
-    return "\n".join(out)
+    return b"\n".join(["\n".join(out).encode("ascii"), *p_out, f"{term:<72}T{1:07d}\n".encode("ascii")])
 
 
 def write_iges(path, entities, **options) -> str:
@@ -772,8 +808,7 @@ def write_iges(path, entities, **options) -> str:
     """
     path = os.fspath(path)
     options.setdefault("file_name", os.path.basename(path))
-    text = to_string(entities, **options)
-    atomic_write(path, text.encode("ascii"))
+    atomic_write(path, to_bytes(entities, **options))
     return path
 
 
