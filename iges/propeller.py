@@ -128,7 +128,7 @@ def _check_consistency(model, blade_items, sector) -> None:
         # surface whose control points reach beyond R while the surface stays inside
         # (Propeller definition: MAX_TIP_CHORD_RATIO)
         (u0, u1), (v0, v1) = s.domain_u, s.domain_v
-        X = s.evaluate(np.linspace(u0, u1, RANGE_CHECK_SAMPLES)[:, None], np.linspace(v0, v1, RANGE_CHECK_SAMPLES)[None, :])
+        X = s.evaluate_grid(np.linspace(u0, u1, RANGE_CHECK_SAMPLES), np.linspace(v0, v1, RANGE_CHECK_SAMPLES))
         r = np.hypot(X[..., 0], X[..., 1])
         if r.max() < R_hub - reach or r.max() > 0.5 * D * (1.0 + ROOT_CHECK_FRACTION):
             raise GeometryError(f"blade surface {label} does not lie between the hub (r = {R_hub:.6g} m) "

@@ -377,8 +377,28 @@ def curve_flags(curve: BSplineCurve126, resolution: float) -> tuple[int, int, in
     return int(planar), int(closed), int(curve.is_polynomial), int(periodic), (normal if planar else np.zeros(3))
 
 
+def _corners_apart(surface: BSplineSurface128, resolution: float) -> bool:
+    """Whether the surface is certainly open in both directions, from its control net
+    alone: with knots clamped at the ends of the parameter range the corners are the net's
+    corner points (up to rounding in the last bits, far below the margin here), and both
+    pairs of opposite sides have a corner pair farther apart than the resolution."""
+    p, q = surface.degree_u, surface.degree_v
+    U, V = surface.knots_u, surface.knots_v
+    (u0, u1), (v0, v1) = surface.parameter_range_u, surface.parameter_range_v
+    if not (np.all(U[: p + 1] == u0) and np.all(U[-p - 1 :] == u1)
+            and np.all(V[: q + 1] == v0) and np.all(V[-q - 1 :] == v1)):
+        return False
+    P = surface.control_points
+    c00, c10, c01, c11 = P[0, 0], P[-1, 0], P[0, -1], P[-1, -1]
+    margin = resolution + 1e-9 * (1.0 + float(np.max(np.abs([c00, c10, c01, c11]))))
+    d = np.linalg.norm(np.array([c00 - c10, c01 - c11, c00 - c01, c10 - c11]), axis=-1)
+    return bool(max(d[0], d[1]) > margin and max(d[2], d[3]) > margin)
+
+
 def surface_flags(surface: BSplineSurface128, resolution: float) -> tuple[int, int, int, int, int]:
     """(PROP1 closed u, PROP2 closed v, PROP3 polynomial, PROP4 periodic u, PROP5 periodic v)."""
+    if _corners_apart(surface, resolution):  # the usual case, settled without evaluating
+        return 0, 0, int(surface.is_polynomial), 0, 0
     S = bspline_surface(surface)
     (u0, u1), (v0, v1) = surface.parameter_range_u, surface.parameter_range_v
     nu, nv = surface.control_points.shape[:2]

@@ -124,6 +124,42 @@ def _scaled_integers(m: np.ndarray, t: np.ndarray) -> np.ndarray:
     return hi.astype(np.int64) + np.rint(lo).astype(np.int64)
 
 
+def _is_bulk(a: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """The reals that "%.17g" writes in positional form with a fraction (the others are
+    written by :func:`format_real`)."""
+    return (m >= 1e-4) & (m < 1e17) & (a != np.trunc(a))
+
+
+def _digit_words(m: np.ndarray):
+    """For magnitudes 1e-4 <= m < 1e17: (t, words, trailing): m = D · 10**-t with D the
+    17-digit integer nearest to m · 10**t (:func:`_scaled_integers`), D's digits as five
+    little-endian 4-byte words (the leading digit in the last byte of the first word, then
+    four groups of four looked up in a table of "0000".."9999"), and the number of
+    trailing zero digits of D (the fraction is never all zero)."""
+    t = 16 - np.floor(np.log10(m)).astype(np.intp)
+    D = _scaled_integers(m, t)
+    for _ in range(2):  # log10 may be one off next to a power of ten
+        wrong = np.flatnonzero((D >= 10**17) | (D < 10**16))
+        if not wrong.size:
+            break
+        t[wrong] += np.where(D[wrong] < 10**16, 1, -1)
+        D[wrong] = _scaled_integers(m[wrong], t[wrong])
+    # D = lead · 10**16 + g1 · 10**12 + g2 · 10**8 + g3 · 10**4 + g4, in 32-bit arithmetic
+    # after one 64-bit division
+    hi, lo = np.divmod(D, 10**8)
+    lead, h8 = np.divmod(hi.astype(np.uint32), np.uint32(10**8))
+    g1, g2 = np.divmod(h8, np.uint32(10**4))
+    g3, g4 = np.divmod(lo.astype(np.uint32), np.uint32(10**4))
+    words = np.empty((D.size, 5), dtype="<u4")
+    words[:, 0] = (np.uint32(_ZERO) + lead) << np.uint32(24)
+    for col, group in ((1, g1), (2, g2), (3, g3), (4, g4)):
+        words[:, col] = np.take(_FOUR_DIGITS, group)
+    tz = _TRAILING_ZEROS
+    trailing = np.take(tz, g4) + (g4 == 0) * (
+        np.take(tz, g3) + (g3 == 0) * (np.take(tz, g2) + (g2 == 0) * np.take(tz, g1)))
+    return t, words, trailing
+
+
 def _bulk_reals(a: np.ndarray) -> str:
     """``",".join("%.17g" % x ...)`` for reals with 1e-4 <= |x| < 1e17 and a fraction
     (byte-identical to C's printf, which rounds the exact binary value to 17 significant
@@ -134,39 +170,17 @@ def _bulk_reals(a: np.ndarray) -> str:
     16 - t (or "0.000" before them) and drops trailing zeros of the fraction."""
     values = a
     m = np.abs(a)
-    bulk = (m >= 1e-4) & (m < 1e17) & (a != np.trunc(a))
+    bulk = _is_bulk(a, m)
     special = None if bulk.all() else np.flatnonzero(~bulk)
     if special is not None:
         keep = np.flatnonzero(bulk)
         a, m = a[keep], m[keep]
-    t = 16 - np.floor(np.log10(m)).astype(np.intp)
-    D = _scaled_integers(m, t)
-    for _ in range(2):  # log10 may be one off next to a power of ten
-        wrong = np.flatnonzero((D >= 10**17) | (D < 10**16))
-        if not wrong.size:
-            break
-        t[wrong] += np.where(D[wrong] < 10**16, 1, -1)
-        D[wrong] = _scaled_integers(m[wrong], t[wrong])
-    # the 17 digits as five little-endian 4-byte words: the leading digit in the last byte
-    # of the first word, then four groups of four looked up in a table of "0000".."9999";
-    # trailing zeros of the fraction are dropped (as "%g" drops them) by zeroing their
-    # bytes (the fraction is never all zero)
-    words = np.empty((D.size, 5), dtype="<u4")
-    rest = D
-    trailing = np.zeros(D.size, dtype=np.int64)
-    all_zero = np.ones(D.size, dtype=bool)
-    for col in (4, 3, 2, 1):
-        group = rest % 10**4
-        rest = rest // 10**4
-        words[:, col] = np.take(_FOUR_DIGITS, group)
-        trailing += np.where(all_zero, np.take(_TRAILING_ZEROS, group), 0)
-        all_zero &= group == 0
-    words[:, 0] = (_ZERO + rest.astype("<u4")) << 24
+    t, words, trailing = _digit_words(m)
     for col in (4, 3, 2, 1):  # zeros dropped from this word: min(4, max(0, trailing - 4 (4 - col)))
         drop = np.clip(trailing - 4 * (4 - col), 0, 4)
         words[:, col] &= np.take(_KEEP_MASK, drop)
     digits = words.view(np.uint8)[:, 3:]  # (n, 17)
-    rows = np.zeros((D.size, 24), dtype=np.uint8)  # sign, up to 22 characters, comma
+    rows = np.zeros((t.size, 24), dtype=np.uint8)  # sign, up to 22 characters, comma
     rows[:, 0] = np.where(a < 0, _MINUS, 0)
     rows[:, 23] = _COMMA
     X = 16 - t  # the decimal exponent, -4 <= X <= 16
@@ -344,6 +358,189 @@ def _pd(entity: Entity, de: dict, resolution: float) -> str:
     return ",".join(parts) + ";"
 
 
+# -- parameter lines of large entities, laid out by array arithmetic ---------------------------
+#: A P line: 64 data columns, a blank, the 7-digit DE pointer, "P", the 7-digit sequence
+#: number, and the newline that joins the lines.
+_LINE = 81
+_SPACE, _NEWLINE, _LETTER_P = 32, 10, ord("P")
+
+
+def _digit_offsets() -> np.ndarray:
+    """Where the digits of a bulk real go, relative to the first character after its
+    sign, by decimal exponent X = -4..16 and number of kept digits k = 1..17: row
+    (X + 4) · 18 + k, column j (X >= 0: j + (j > X), the point after digit X; X < 0:
+    1 - X + j, after "0." and -X - 1 zeros). Dropped digits hold -1."""
+    J = np.arange(17)
+    table = np.full((21 * 18, 17), -1, dtype=np.int64)
+    for X in range(-4, 17):
+        off = J + (J > X) if X >= 0 else 1 - X + J
+        for k in range(1, 18):
+            table[(X + 4) * 18 + k, :k] = off[:k]
+    return table
+
+
+_DIGIT_OFFSETS = _digit_offsets()
+
+
+def _windows(buffer: np.ndarray, width: int) -> np.ndarray:
+    """Every run of ``width`` bytes of ``buffer`` as a row (overlapping rows of a strided
+    view): ``_windows(b, w)[starts] = rows`` writes each row at its start in one call,
+    deterministic as long as the runs written by one call do not overlap."""
+    return np.lib.stride_tricks.as_strided(buffer, shape=(buffer.size - width + 1, width), strides=(1, 1))
+
+
+#: "P" and the sequence number's last 3 + 4 digits: the characters of columns 73-80.
+_P_WORD = np.uint32(ord("P"))
+
+
+def _bulk_parts(entity: Entity, resolution: float):
+    """(head, reals, tail) of a 128 or 126 whose control net is written in bulk: the
+    parameter string is ``head + _reals(reals) + "," + tail`` (head ends with its
+    delimiter, tail with ";"); None for other entities and for nets :func:`_reals` writes
+    otherwise (small, or all one value)."""
+    if isinstance(entity, BSplineSurface128):
+        P = entity.control_points
+        nu, nv = P.shape[:2]
+        flags = surface_flags(entity, resolution)
+        (u0, u1), (v0, v1) = entity.parameter_range_u, entity.parameter_range_v
+        head = ["128", str(nu - 1), str(nv - 1), str(entity.degree_u), str(entity.degree_v), *map(str, flags),
+                _reals(entity.knots_u), _reals(entity.knots_v), _reals(entity.weights.T)]
+        reals = P.transpose(1, 0, 2)
+        tail = _reals([u0, u1, v0, v1]) + ";"
+    elif isinstance(entity, BSplineCurve126):
+        planar, closed, poly, periodic, normal = curve_flags(entity, resolution)
+        n = entity.control_points.shape[0]
+        head = ["126", str(n - 1), str(entity.degree), str(planar), str(closed), str(poly), str(periodic),
+                _reals(entity.knots), _reals(entity.weights)]
+        reals = entity.control_points
+        tail = _reals(entity.parameter_range) + "," + _reals(normal) + ";"
+    else:
+        return None
+    a = np.asarray(reals, dtype=np.float64).ravel()
+    if a.size <= SHORTEST_REPR_SIZE or np.all(a == a[0]):
+        return None
+    return ",".join(head) + ",", a, tail
+
+
+def _token_lengths(text: bytes) -> np.ndarray:
+    """Lengths of the tokens of ``text`` (each ends with its delimiter ',' or ';')."""
+    b = np.frombuffer(text, dtype=np.uint8)
+    ends = np.flatnonzero((b == _COMMA) | (b == 59))
+    return np.diff(ends, prepend=-1)
+
+
+def _place_text(out: np.ndarray, text: bytes, lengths: np.ndarray, pos: np.ndarray) -> None:
+    """Write the tokens of ``text`` (their lengths) at the buffer positions ``pos``."""
+    if not lengths.size:
+        return
+    starts = np.cumsum(lengths) - lengths
+    token = np.repeat(np.arange(lengths.size), lengths)
+    out[pos[token] + (np.arange(len(text)) - starts[token])] = np.frombuffer(text, dtype=np.uint8)
+
+
+def _orbit(step: np.ndarray, n: int) -> np.ndarray:
+    """0, f(0), f(f(0)), ... up to and including n, for f = ``step`` on 0..n-1 (f(i) > i,
+    increasing) and f(n) = n: the line starts of greedy filling. By repeated squaring
+    (f, f², f⁴, ... until f^(2^K)(0) = n) and expansion from the coarsest level down,
+    each level one array operation instead of one Python step per line."""
+    levels = [np.append(step, n)]
+    while levels[-1][0] != n:
+        f = levels[-1]
+        levels.append(f[f])
+    A = np.zeros(1, dtype=np.int64)
+    for f in reversed(levels[:-1]):  # A = f^0 .. f^(2^k - 1) of 0, doubled each level
+        B = np.empty(2 * A.size, dtype=np.int64)
+        B[0::2] = A
+        B[1::2] = f[A]
+        A = B
+    A = np.append(A, n)
+    return A[: int(np.searchsorted(A, n)) + 1]
+
+
+def _bulk_lines(head: str, a: np.ndarray, tail: str, seq: int, pseq: int) -> tuple[bytes, int]:
+    """The P lines of ``head + _reals(a) + "," + tail`` (``a`` with more than
+    SHORTEST_REPR_SIZE values, not all equal), byte for byte what ``_pack`` and the line
+    format give, built by array arithmetic instead of per-token and per-line strings.
+
+    Every token's length is known before its text: a bulk real (:func:`_bulk_reals`)
+    takes sign + kept digits + point + comma, and for X < 0 the "0" and -X - 1 zeros
+    before the digits. Greedy line filling (the longest run of whole tokens of at most 64
+    columns) then gives each token's line and column, hence its place in the (lines, 81)
+    byte block, and every character is written straight to its place: digits, points,
+    signs and commas of all bulk reals in a few array assignments (the dropped trailing
+    zeros go to a scratch byte past the block), the other tokens from their text."""
+    head_b, tail_b = head.encode("ascii"), tail.encode("ascii")
+    m = np.abs(a)
+    bulk = _is_bulk(a, m)
+    ib = np.flatnonzero(bulk)
+    t, words, trailing = _digit_words(m[ib])
+    e = 16 - t  # the decimal exponent X, -4 <= X <= 16
+    neg = (a[ib] < 0).astype(np.int64)
+    kept = 17 - trailing
+    lengths = np.empty(a.size, dtype=np.int64)
+    lengths[ib] = neg + kept + 2 + np.maximum(0, -e)
+    special = None if ib.size == a.size else np.flatnonzero(~bulk)
+    if special is not None:
+        special_b = "".join([format_real(x) + "," for x in a[special].tolist()]).encode("ascii")
+        lengths[special] = _token_lengths(special_b)
+    head_len, tail_len = _token_lengths(head_b), _token_lengths(tail_b)
+    lengths = np.concatenate([head_len, lengths, tail_len])
+    cum = np.concatenate([[0], np.cumsum(lengths)])
+    # greedy filling: from token i, a line takes the tokens up to the last end within 64 columns
+    reach = np.searchsorted(cum, cum[:-1] + PD_COLUMNS, side="right") - 1
+    if np.any(reach <= np.arange(lengths.size)):
+        raise IgesError(f"a parameter is longer than {PD_COLUMNS} columns")
+    starts = _orbit(reach, lengths.size)
+    L = starts.size - 1
+    per_line = np.diff(starts)
+    pos = np.repeat(np.arange(L) * _LINE - cum[starts[:-1]], per_line) + cum[:-1]
+    scratch = L * _LINE
+    out = np.empty(2 * scratch + 64, dtype=np.uint8)
+    out[:scratch] = _SPACE
+    h = head_len.size
+    _place_text(out, head_b, head_len, pos[:h])
+    _place_text(out, tail_b, tail_len, pos[h + a.size:])
+    pos_a = pos[h : h + a.size]
+    if special is not None:
+        _place_text(out, special_b, lengths[h + special], pos_a[special])
+    p = pos_a[ib] + neg  # where the digits (or the "0." before them) start
+    out[p[neg == 1] - 1] = _MINUS
+    out[pos_a[ib] + lengths[h + ib] - 1] = _COMMA
+    digits = words.view(np.uint8)[:, 3:]  # (n, 17)
+    # all 17 digits kept (the usual case): the digits are one run of 17 bytes (X < 0), or
+    # two runs round the point (X >= 0: all 17 one place on, then the integer part over
+    # them, then the point); the runs of one call never overlap (each token is longer)
+    full = kept == 17
+    whole = np.flatnonzero(full & (e < 0))
+    _windows(out, 17)[p[whole] + 1 - e[whole]] = digits[whole]
+    split_ = np.flatnonzero(full & (e >= 0))
+    _windows(out, 17)[p[split_] + 1] = digits[split_]
+    for x in np.unique(e[split_]).tolist():
+        g = split_[e[split_] == x]
+        _windows(out, x + 1)[p[g]] = digits[g, : x + 1]
+    # trailing zeros dropped: digit by digit, the dropped ones sent to a scratch area as
+    # long as the block, past its end, which is never read
+    rest = np.flatnonzero(~full)
+    if rest.size:
+        table = np.where(_DIGIT_OFFSETS < 0, scratch + 1 + 32, _DIGIT_OFFSETS)
+        out[p[rest, None] + np.take(table, (e[rest] + 4) * 18 + kept[rest], axis=0)] = digits[rest]
+    positional = np.flatnonzero(e >= 0)
+    out[p[positional] + e[positional] + 1] = _DOT
+    for x in (-1, -2, -3, -4):  # "0." and -X - 1 zeros before the digits
+        g = np.flatnonzero(e == x)
+        if g.size:
+            _windows(out, 1 - x)[p[g]] = np.frombuffer(b"0." + b"0" * (-x - 1), dtype=np.uint8)
+    block = out[:scratch].reshape(L, _LINE)
+    block[:, PD_COLUMNS + 1 : PD_COLUMNS + 8] = np.frombuffer(b"%7d" % seq, dtype=np.uint8)
+    high, low = np.divmod(np.arange(pseq, pseq + L), 10**4)  # the sequence number < 10**7
+    tail_words = np.empty((L, 2), dtype="<u4")
+    tail_words[:, 0] = (np.take(_FOUR_DIGITS, high) & np.uint32(0xFFFFFF00)) | _P_WORD
+    tail_words[:, 1] = np.take(_FOUR_DIGITS, low)
+    block[:, PD_COLUMNS + 8 : PD_COLUMNS + 16] = tail_words.view(np.uint8)
+    block[:, _LINE - 1] = _NEWLINE
+    return out[: scratch - 1].tobytes(), L
+
+
 #: Greedy line filling: the longest run of at most PD_COLUMNS characters ending in a delimiter.
 _PD_LINE = re.compile(r".{0,%d}[,;]" % (PD_COLUMNS - 1), re.DOTALL)
 
@@ -495,10 +692,20 @@ def _global_lines(h: GlobalSection) -> list[str]:
 
 
 # -- the file -----------------------------------------------------------------------------------
-def to_string(entities, *, units: str = "m", resolution: float | None = None, header: GlobalSection | None = None,
-              start: str | None = None, file_name: str = "", author: str = "", organization: str = "",
-              timestamp: _dt.datetime | None = None) -> str:
+def to_string(entities, **options) -> str:
     """The IGES file for ``entities`` (records, or an :class:`IgesModel` read before) as text.
+
+    Options: units, resolution, header, start, file_name, author, organization, timestamp
+    (:func:`to_bytes`).
+    """
+    return to_bytes(entities, **options).decode("ascii")
+
+
+def to_bytes(entities, *, units: str = "m", resolution: float | None = None, header: GlobalSection | None = None,
+             start: str | None = None, file_name: str = "", author: str = "", organization: str = "",
+             timestamp: _dt.datetime | None = None) -> bytes:
+    """The IGES file for ``entities`` (records, or an :class:`IgesModel` read before) as
+    ASCII bytes (what :func:`write_iges` writes; :func:`to_string` decodes them).
 
     Entities that the given ones reference are written too. ``header`` (a
     :class:`GlobalSection`) overrides units/resolution/author/...; a model read from a file
@@ -568,25 +775,29 @@ def to_string(entities, *, units: str = "m", resolution: float | None = None, he
     pseq = 1
     for e in order:
         seq = de[id(e)]
-        chunks = _pack(_pd(e, de, res), PD_COLUMNS)
-        # one C-level format for all lines of the entity: "%-64s" data, back-pointer, sequence
-        fmt = ("%%-64s %7dP%%07d" % seq,) * len(chunks)
-        p_out.append("\n".join(fmt) % tuple(chain.from_iterable(zip(chunks, range(pseq, pseq + len(chunks))))))
+        parts = _bulk_parts(e, res)
+        if parts is not None:  # a large net: laid out by array arithmetic
+            text, n_lines = _bulk_lines(*parts, seq, pseq)
+            p_out.append(text)
+        else:
+            chunks = _pack(_pd(e, de, res), PD_COLUMNS)
+            n_lines = len(chunks)
+            # one C-level format for all lines of the entity: "%-64s" data, back-pointer, sequence
+            fmt = ("%%-64s %7dP%%07d" % seq,) * n_lines
+            text = "\n".join(fmt) % tuple(chain.from_iterable(zip(chunks, range(pseq, pseq + n_lines))))
+            p_out.append(text.encode("ascii"))
         t = e.type_number
         tr = de[id(e.transform)] if e.transform is not None else 0
         status = _status(e, referenced, param)
         d_out.append(f"{t:8d}{pseq:8d}{0:8d}{0:8d}{0:8d}{0:8d}{tr:8d}{0:8d}{status}D{seq:07d}")
-        d_out.append(f"{t:8d}{0:8d}{0:8d}{len(chunks):8d}{e.form:8d}{'':8}{'':8}{e.label:>8}"
+        d_out.append(f"{t:8d}{0:8d}{0:8d}{n_lines:8d}{e.form:8d}{'':8}{'':8}{e.label:>8}"
                      f"{e.subscript:8d}D{seq + 1:07d}")
-        pseq += len(chunks)
+        pseq += n_lines
     if pseq - 1 > 9_999_999:
         raise IgesError("too many parameter lines for 7-digit sequence numbers")
     out += d_out
-    out += p_out
     term = f"S{len(s_lines):7d}G{len(g_lines):7d}D{len(d_out):7d}P{pseq - 1:7d}"
-    out.append(f"{term:<72}T{1:07d}")
-    out.append("")
-    return "\n".join(out)
+    return b"\n".join(["\n".join(out).encode("ascii"), *p_out, f"{term:<72}T{1:07d}\n".encode("ascii")])
 
 
 def write_iges(path, entities, **options) -> str:
@@ -597,8 +808,7 @@ def write_iges(path, entities, **options) -> str:
     """
     path = os.fspath(path)
     options.setdefault("file_name", os.path.basename(path))
-    text = to_string(entities, **options)
-    atomic_write(path, text.encode("ascii"))
+    atomic_write(path, to_bytes(entities, **options))
     return path
 
 

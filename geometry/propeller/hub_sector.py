@@ -573,7 +573,10 @@ def _loop_integral(spine: BSplineCurve, curve: BSplineCurve, breaks=None) -> flo
     sub = max(1, int(np.ceil(LOOP_MIN_PIECES / (B.size - 1))))
     nodes, weights = _gauss_pieces(B, sub, LOOP_GAUSS_POINTS)
     D = curve.derivatives(nodes, 1)
-    return float(np.sum(area_primitive(spine, D[..., 0, 0]) * D[..., 1, 1] * weights))
+    # G once per distinct s: the end lines p_h2, p_h4 keep s constant over all their nodes
+    s_values, where = np.unique(D[..., 0, 0], return_inverse=True)
+    G = area_primitive(spine, s_values)[where].reshape(D.shape[:-2])
+    return float(np.sum(G * D[..., 1, 1] * weights))
 
 
 def trimmed_area(spine: BSplineCurve, loops) -> float:
