@@ -299,7 +299,28 @@ LOOP_STEP = 1 / 4096
 #: model level: interior samples of a trimmed face, per side of its loops' (u, v) box
 INTERIOR_SAMPLES = 49
 #: model level: loop samples per span (and per radian of arcs) this many times the display's
-MODEL_SAMPLES = 4
+MODEL_SAMPLES = 8
+
+
+def _refined_extremes(evaluate, grid, X, boundary, loops, lo, hi) -> np.ndarray:
+    """Interior points of a face that reach past its boundary in some coordinate direction:
+    from the best grid sample, a bounded local search on the exact surface, kept when it
+    ends inside the loops."""
+    from scipy.optimize import minimize
+
+    from bladesmith.iges.tessellate import inside
+
+    out = []
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            k = int(np.argmax(sign * X[:, axis]))
+            if sign * X[k, axis] <= sign * (boundary[:, axis].max() if sign > 0 else boundary[:, axis].min()):
+                continue  # the boundary reaches farther: the extreme is on it
+            res = minimize(lambda q: -sign * float(evaluate(q[None, :])[0, axis]), grid[k], method="L-BFGS-B",
+                           bounds=list(zip(lo, hi)), options={"ftol": 1e-15, "gtol": 1e-14})
+            if inside(res.x[None, :], loops)[0]:
+                out.append(evaluate(res.x[None, :])[0])
+    return np.array(out).reshape(-1, 3)
 
 
 @contextlib.contextmanager
@@ -337,7 +358,10 @@ def model_level():
         grid = grid[inside(grid, loops)]
         boundary = evaluate(np.concatenate(dense))
         imp._check_range(boundary, record)
-        imp.items.append(ImportItem(name, "mesh", geometry={"boundary": boundary, "interior": evaluate(grid)},
+        interior = evaluate(grid)
+        if len(grid):
+            interior = np.concatenate([interior, _refined_extremes(evaluate, grid, interior, boundary, loops, lo, hi)])
+        imp.items.append(ImportItem(name, "mesh", geometry={"boundary": boundary, "interior": interior},
                                     exact=exact))
 
     from bladesmith.iges import importer
@@ -391,6 +415,16 @@ def _box(P: np.ndarray) -> np.ndarray:
     return np.array([P.min(axis=0), P.max(axis=0)])
 
 
+def _edge_reference(edges: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """OCC's box of its edges, clipped to its box of the shape. The faces' boundaries lie on
+    the faces, but OCC's edge curves need not: in files whose model-space curves are
+    approximations, OCC's edges stand off the surfaces by the file's tolerance, and its
+    edge box goes past its own box of the faces (smlibpy's torus_faces.igs by 5.5e-6 m,
+    1.6e-4 of the diagonal; occt-misc's hammer.iges by 1.8e-4 m, 4.4e-6); ours, the loops
+    put on the exact surfaces, then meet OCC's box of the faces to 1e-10."""
+    return np.array([np.maximum(edges[0], faces[0]), np.minimum(edges[1], faces[1])])
+
+
 def compare(files, progress=None, mesh: bool = True) -> list[Row]:
     """One :class:`Row` per file. ``mesh``: the importer as the operator runs it (trimmed
     faces tessellated; the box of the meshes); else at the model level (:func:`model_level`,
@@ -420,7 +454,7 @@ def compare(files, progress=None, mesh: bool = True) -> list[Row]:
             err = float(np.abs(box - occ_box).max()) / diag
             if not mesh and occ_edges[0] is not None:
                 edges = _box(np.concatenate([_item_boundary(it) for it in report.items]))
-                edge_err = float(np.abs(edges - occ_edges[0]).max()) / diag
+                edge_err = float(np.abs(edges - _edge_reference(occ_edges[0], occ_box)).max()) / diag
         rows.append(Row(f.name, occ_n, faces, report.counts.get("curve", 0), err, dt, occ_t,
                         report.skipped_summary()[:160], edge_err))
         if progress:
