@@ -779,6 +779,23 @@ def _order_loops(loops: list) -> list:
     return sorted(loops, key=area, reverse=True)
 
 
+def _chain_gap(pts: list) -> float:
+    """Sum of the jumps from each piece's end to the next piece's start, around the loop."""
+    return sum(float(np.linalg.norm(pts[k][-1] - pts[(k + 1) % len(pts)][0])) for k in range(len(pts)))
+
+
+def _orient_parameter_curves(pts: list, flip: list) -> list:
+    """The 508 pieces with the parameter-space curves of the edges used against their
+    model-space curve (OF = 0) run the way the loop goes. Writers differ: OpenCASCADE writes
+    (and reads) them in the loop's direction already, others (Bladesmith's propeller solid)
+    along the edge's curve, to be reversed. Of the two readings, the one whose pieces join
+    up (smaller sum of the gaps between consecutive pieces) is taken; OpenCASCADE's on a tie."""
+    other = list(pts)
+    for k in flip:
+        other[k] = pts[k][::-1]
+    return other if _chain_gap(other) < _chain_gap(pts) else pts
+
+
 def _face_loops(imp, face: Face510) -> list:
     loops = []
     analytic = isinstance(face.surface, AnalyticSurface)
@@ -793,6 +810,7 @@ def _face_loops(imp, face: Face510) -> list:
         # vertex edges (a pole or a degenerate side) with parameter curves: their uv
         # steps are part of the loop in parameter space on other surfaces
         steps = {} if analytic else {k: ps for k, _, ps in loop.vertex_edges if ps}
+        flip = []  # indices in pts of parameter-space curves of edges used against their curve
         for j, (e, ndx, same, ps) in enumerate(loop.edges):
             if j in steps:
                 pts.append(np.concatenate([np.concatenate(list(imp._param_points(q, 0)))[:, :2]
@@ -803,11 +821,17 @@ def _face_loops(imp, face: Face510) -> list:
                 seg = _model_to_uv(imp, face.surface, e.curves[ndx])
             elif ps:
                 seg = np.concatenate([np.concatenate(list(imp._param_points(q, 0)))[:, :2] for q in ps])
+                if not same:
+                    flip.append(len(pts))
+                pts.append(seg)
+                continue
             else:
                 seg = _model_to_uv(imp, face.surface, e.curves[ndx])
             pts.append(seg if same else seg[::-1])
         for ps in steps.values():  # after the last edge
             pts.append(np.concatenate([np.concatenate(list(imp._param_points(q, 0)))[:, :2] for q in ps]))
+        if flip:
+            pts = _orient_parameter_curves(pts, flip)
         loops.append(unwrap_loop(face.surface, pts, jumps) if analytic else np.concatenate(pts))
     return loops if face.outer_first else _order_loops(loops)
 

@@ -384,6 +384,14 @@ class _Importer:
             P = foreign.unwrap_loop(cos.surface, edges)
         elif cos.parameter_curve is not None and not isinstance(cos.surface, foreign.Plane108):
             P = np.concatenate(list(self._param_points(cos.parameter_curve, 0)))[:, :2]
+            if cos.model_curve is not None and not np.all(np.ptp(P, axis=0) > 0):
+                # a parameter-space loop with no area (freecad-common's SOD_323.igs: two
+                # whose u stays at -0.01) beside a model-space one: OCC builds the face from
+                # the model-space curve, and so do we, where it can be mapped onto the surface
+                try:
+                    P = foreign._model_to_uv(self, cos.surface, cos.model_curve)
+                except IgesError:
+                    pass
         elif cos.model_curve is not None:
             P = foreign._model_to_uv(self, cos.surface, cos.model_curve)
         else:

@@ -173,3 +173,87 @@ def test_cylinder_face_with_model_space_loop_matches_opencascade(tmp_path):
     assert abs(_mesh_area(report) - occ_area) <= 2e-3 * occ_area
     box = ours_box(report)
     assert np.all(box[0] >= occ_box[0] - 1e-6) and np.all(box[1] <= occ_box[1] + 1e-6)
+
+
+def _bump_face_brep_iges(path):
+    """One face on a bicubic B-spline bump (highest at the middle, inside the face) bounded by
+    its four sides, written by OpenCASCADE as a B-rep solid (186/510/508): two of the four
+    edges are used against their curve (OF = 0), with their parameter-space curves written
+    the way the loop goes."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.IGESControl import IGESControl_Reader, IGESControl_Writer
+    from OCP.Interface import Interface_Static
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    from bladesmith.geometry.nurbs import BSplineSurface
+    from bladesmith.iges.convert import surface_from_geometry
+    from bladesmith.iges.writer import to_string
+
+    # the bicubic bump, as a lone 128 that OCC reads, then writes as a B-rep face
+    net = np.zeros((4, 4, 3))
+    for i in range(4):
+        for j in range(4):
+            net[i, j] = (10.0 * i, 8.0 * j, 30.0 if i in (1, 2) and j in (1, 2) else 0.0)
+    knots = [0.0] * 4 + [1.0] * 4
+    lone = path.with_suffix(".128.igs")
+    lone.write_text(to_string([surface_from_geometry(BSplineSurface(3, 3, knots, knots, net))], units="mm"))
+    r = IGESControl_Reader()
+    r.ReadFile(str(lone))
+    r.TransferRoots()
+    explorer = TopExp_Explorer(r.OneShape(), TopAbs_FACE)
+    surface = BRep_Tool.Surface_s(TopoDS.Face(explorer.Current()))
+    face = BRepBuilderAPI_MakeFace(surface, 0.0, 1.0, 0.0, 1.0, 1e-7).Face()
+    before = Interface_Static.IVal_s("write.iges.brep.mode")
+    try:
+        Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
+        w = IGESControl_Writer("MM", 1)
+        w.AddShape(face)
+        w.ComputeModel()
+        assert w.Write(str(path))
+    finally:
+        Interface_Static.SetIVal_s("write.iges.brep.mode", before)
+
+
+def test_brep_face_loop_with_reversed_edges_matches_opencascade(tmp_path):
+    """The 508 loop's parameter-space curves of OF = 0 edges run the way the loop goes in
+    OpenCASCADE's files: reversing them crossed the loop, and the face lost its middle (the
+    bump's top, 16.9 mm up, was lost; occt-misc's MAT.brep.igs 2.8e-2 of the diagonal)."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.IGESControl import IGESControl_Reader
+
+    path = tmp_path / "bump.igs"
+    _bump_face_brep_iges(path)
+    text = path.read_text()
+    assert "\n508," in "\n" + "\n".join(line[:72] for line in text.splitlines())
+    occ_faces, occ_box, _ = corpus.occ_summary(path)
+    report = import_path(path)
+    assert report.counts.get("mesh", 0) == occ_faces == 1, report.skipped_summary()
+    r = IGESControl_Reader()
+    r.ReadFile(str(path))
+    r.TransferRoots()
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(r.OneShape(), props)
+    occ_area = props.Mass() * 1e-6
+    assert abs(_mesh_area(report) - occ_area) <= 2e-3 * occ_area, (_mesh_area(report), occ_area)
+    box = ours_box(report)
+    diag = np.linalg.norm(occ_box[1] - occ_box[0])
+    assert np.abs(box - occ_box).max() <= 2e-3 * diag, (box, occ_box)
+    assert box[1, 2] > 0.0168  # the bump's top (16.875 mm) is inside the face
+
+
+def test_loop_pieces_oriented_either_way():
+    """Both conventions for OF = 0 parameter curves: as written (OpenCASCADE) and along the
+    edge's curve (Bladesmith's propeller solid): the reading whose pieces join is taken."""
+    from bladesmith.iges.foreign import _orient_parameter_curves
+
+    square = [np.array([[0.0, 0.0], [1.0, 0.0]]), np.array([[1.0, 0.0], [1.0, 1.0]]),
+              np.array([[1.0, 1.0], [0.0, 1.0]]), np.array([[0.0, 1.0], [0.0, 0.0]])]
+    as_written = _orient_parameter_curves(square, [2, 3])
+    assert all(a is b for a, b in zip(as_written, square))
+    along_curve = [square[0], square[1], square[2][::-1], square[3][::-1]]
+    fixed = _orient_parameter_curves(along_curve, [2, 3])
+    assert all(np.array_equal(a, b) for a, b in zip(fixed, square))

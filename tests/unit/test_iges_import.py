@@ -119,6 +119,34 @@ def test_plane_108_face_bounded_by_model_space_loops():
     assert not report.skipped
 
 
+def test_face_whose_parameter_loop_has_no_area_takes_its_model_space_loop():
+    """A 144 over a 128 (the plane z = 0 over [0, 4] x [0, 3]) whose 142 has a parameter
+    curve stuck on u = 0 (no area, as two faces of freecad-common's SOD_323.igs) and a
+    model-space rectangle [0.5, 3.5] x [0.5, 2.5]: the face comes from the model-space
+    curve, as OpenCASCADE makes it, not refused."""
+    surface = (128, [1, 1, 1, 1, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 1, 1, 1, 1,
+                     0, 0, 0, 4, 0, 0, 0, 3, 0, 4, 3, 0, 0, 1, 0, 1], 0, 0, "01")
+    ents = [surface]
+    first = len(ents) + 1
+    for a, b in (((0, 0), (0, 1)), ((0, 1), (0, 0))):  # the stuck parameter curve
+        ents.append((110, [a[0], a[1], 0.0, b[0], b[1], 0.0], 0, 0, "01"))
+    ents.append((102, [2, f"@{first}", f"@{first + 1}"], 0, 0, "01"))
+    param = len(ents)
+    sq = [(0.5, 0.5), (3.5, 0.5), (3.5, 2.5), (0.5, 2.5)]
+    first = len(ents) + 1
+    for a, b in zip(sq, sq[1:] + sq[:1]):
+        ents.append((110, [a[0], a[1], 0.0, b[0], b[1], 0.0], 0, 0, "01"))
+    ents.append((102, [4] + [f"@{first + i}" for i in range(4)], 0, 0, "01"))
+    ents.append((142, [0, "@1", f"@{param}", f"@{len(ents)}", 1], 0, 0, "01"))
+    ents.append((144, ["@1", 1, 0, f"@{len(ents)}"], 0, 0, "00"))
+    report = run(C.raw_file(ents))
+    (item,) = report.items
+    assert not report.skipped, report.skipped_summary()
+    assert abs(mesh_area(item) - 6.0) < 1e-9 * 6.0
+    box = np.array([item.mesh.vertices.min(axis=0), item.mesh.vertices.max(axis=0)])
+    assert np.abs(box - [[0.5, 0.5, 0.0], [3.5, 2.5, 0.0]]).max() < 1e-9
+
+
 def test_tabulated_cylinder_face_with_hole():
     text, quarter = C.tabulated_cylinder_face()
     (item,) = run(text).items
