@@ -102,8 +102,8 @@ CASES = [
     Case("skew72", "skewed_demo", {"skew_deg": lambda s: [1.6 * x for x in s]},
          mesh_xfail="min SICN 0.0092 (2026-11-24): flat triangles on the tip surface against its edge line at r/R "
          "0.93 (2-D quality 7e-4): Hally's cut parameter (Eq. 24) runs up to 85x slower at the edge than "
-         "mid-cut (DTMB 4119's tip cuts), so the tip's |S_v| nearly vanishes there. With the curves at their 3-D arclength (edge_curves."
-         "ARCLENGTH_PARAMETERS) those go, and the slivers move to the tip surface's corner at x_TE, where c_11 "
+         "mid-cut (DTMB 4119's tip cuts), so the tip's |S_v| nearly vanishes there. Tried on a branch: with the curves at their 3-D "
+         "arclength those go, and the slivers move to the tip surface's corner at x_TE, where c_11 "
          "and the skewed trailing edge meet at 159 deg: 0.005 (0.018 adding corners.BEND_TOP_EDGES)"),
     Case("steep_coarse", "", definition=f"{IRREGULAR}/steep_coarse.toml",
          mesh_xfail="min SICN 0.044 (2026-11-24), no longer on the tip (next worst 0.09): a tetrahedron at the hub, "
@@ -112,7 +112,7 @@ CASES = [
     Case("skewed_fast", "", definition=f"{IRREGULAR}/skewed_fast.toml",
          mesh_xfail="min SICN 0.0091 (2026-11-24) against the tip surface's edge line at r/R 0.93, as on skew72; "
          "the tip surface's corner at x_TE is 159 deg (c_11 nearly continues the skewed trailing edge). With "
-         "edge_curves.ARCLENGTH_PARAMETERS: 0.031"),
+         "the curves at their 3-D arclength (tried on a branch): 0.031"),
 ]
 
 _BUILT: dict = {}
