@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,6 +60,99 @@ class _Str(str):
 
 class _StrTokens(list):
     """Parameters of a record in which at least one Hollerith string was read."""
+
+
+#: Parameters of a string-free record split eagerly at each end (integers, pointers and
+#: single reals are read there); the middle, usually a long run of reals, is parsed in bulk.
+_ENDS = 16
+#: Runs of reals at least this long are parsed with one numpy call (:meth:`_Params.reals`).
+_BULK_MIN = 16
+
+
+class _Tokens:
+    """The parameters of a record without strings, split lazily (IGES 5.3 §2.2.3).
+
+    Behaves as the list ``body.split(pd)`` (length, indexing, slicing, iteration) but splits
+    only the first and last :data:`_ENDS` parameters up front; the whole list is built only
+    when something asks for a parameter in the middle. :meth:`reals_from` parses every
+    parameter from an index to the end with one numpy call, so a B-spline's thousands of
+    knots, weights and coordinates never become Python strings."""
+
+    __slots__ = ("body", "pd", "n", "head", "tail", "offsets", "_all")
+
+    def __init__(self, body: str, pd: str):
+        self.body, self.pd, self._all = body, pd, None
+        head = body.split(pd, _ENDS)
+        if len(head) <= _ENDS:  # short record: everything is split already
+            self.n, self.head, self.tail = len(head), head, []
+            self._all = head
+        else:
+            self.n = body.count(pd) + 1
+            self.head = head[:_ENDS]
+            self.tail = body.rsplit(pd, _ENDS)[1:] if self.n > 2 * _ENDS else self.all()[_ENDS:]
+        # character offset of parameter k (k <= _ENDS) in ``body``, for the bulk parse
+        offsets = [0]
+        for t in self.head[:_ENDS]:
+            offsets.append(offsets[-1] + len(t) + 1)
+        self.offsets = offsets
+
+    def all(self) -> list:
+        if self._all is None:
+            self._all = self.body.split(self.pd)
+            self._all[0] = self.head[0]
+        return self._all
+
+    def __len__(self):
+        return self.n
+
+    def __bool__(self):
+        return self.n > 0
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return self.all()[k]
+        if k < 0:
+            k += self.n
+        if 0 <= k < len(self.head):
+            return self.head[k]
+        if self.n - len(self.tail) <= k < self.n:
+            return self.tail[k - self.n + len(self.tail)]
+        return self.all()[k]
+
+    def __setitem__(self, k, value):
+        if k != 0:
+            raise IndexError("only the entity type parameter is replaced")
+        self.head[0] = value
+        if self._all is not None:
+            self._all[0] = value
+
+    def __iter__(self):
+        return iter(self.all())
+
+    def reals_from(self, i: int) -> np.ndarray | None:
+        """Parameters i..n-1 as float64 when every one of them is a finite real written with
+        the characters of IGES reals only, else None (the caller then reads them one by one
+        and names the bad one). The values are those of ``float`` on each parameter: numpy's
+        text parser rounds correctly, and what it would take that ``float`` refuses (a blank
+        parameter, ``nan``, any other character) is ruled out before it runs."""
+        out = None
+        if self.pd == "," and i < len(self.offsets):
+            text = self.body[self.offsets[i]:].encode("latin-1", "replace")
+            if not text.translate(None, _REAL_CHARS):
+                compact = text.replace(b" ", b"") if b" " in text else text
+                # an empty or blank parameter is a default (0.0 here), which numpy would misread
+                if compact and b",," not in compact and compact[:1] != b"," and compact[-1:] != b",":
+                    if b"D" in text or b"d" in text:
+                        text = text.replace(b"D", b"E").replace(b"d", b"e")
+                    try:
+                        with warnings.catch_warnings():
+                            warnings.simplefilter("error")  # numpy: "could not be read to its end"
+                            a = np.fromstring(text, dtype=np.float64, sep=",")
+                    except (ValueError, DeprecationWarning):
+                        a = None
+                    if a is not None and a.size == self.n - i and np.all(np.isfinite(a)):
+                        out = a
+        return out
 
 
 # -- the model -----------------------------------------------------------------------------------
@@ -317,31 +411,40 @@ def _sections_fast(lines):
 
 def _column_integers(f: np.ndarray) -> np.ndarray | None:
     """Right-justified unsigned integers in columns of a uint8 array (one per row, leading
-    blanks, at least the last column a digit); None when any row is not such a number."""
+    blanks, at least the last column a digit); None when any row is not such a number.
+
+    Column by column (a handful of passes over the rows, no (rows, columns) temporaries
+    beyond the digit mask): this runs on every sequence number and back pointer of a file."""
     d = f - np.uint8(48)  # digits 0..9; a blank wraps to 240
     digit = d <= 9
     if not np.all(digit | (f == 32)) or not np.all(digit[:, -1]):
         return None
-    # blanks may only lead: once a digit is seen, no blank follows
-    if np.any(~digit[:, 1:] & np.maximum.accumulate(digit, axis=1)[:, :-1]):
+    # blanks may only lead: no digit is followed by a blank
+    if np.any(digit[:, :-1] > digit[:, 1:]):
         return None
     d[~digit] = 0
-    return d.astype(np.int64) @ (10 ** np.arange(f.shape[1] - 1, -1, -1, dtype=np.int64))
+    value = d[:, 0].astype(np.int64)
+    for k in range(1, f.shape[1]):
+        value *= 10
+        value += d[:, k]
+    return value
 
 
 # -- parameters ----------------------------------------------------------------------------------
 def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of, strip: bool = True) -> list:
     """Parameters of one record up to its record delimiter (IGES 5.3 §2.2.3).
 
-    ``strip=False``: a record without strings comes back as a plain list whose tokens
-    may keep blanks around them (:class:`_Params` strips what it reads one by one, and
-    reads runs of reals without stripping them), which saves a pass over every token."""
+    ``strip=False``: a record without strings comes back as a lazily split
+    :class:`_Tokens` whose tokens may keep blanks around them (:class:`_Params` strips what
+    it reads one by one, and reads runs of reals in bulk without splitting them)."""
     if "H" not in data:
         end = data.find(rd)
         if end < 0:
             src.error("missing record delimiter", line_of(len(data) - 1))
         body = data[:end]
-        if " " not in body or not strip:
+        if not strip:
+            return _Tokens(body, pd)
+        if " " not in body:
             return body.split(pd)
         return [t.strip() for t in body.split(pd)]
     out = _StrTokens()
@@ -409,6 +512,9 @@ class _Params:
         self.line_of_index = line_of_index
         self.n_entities = n_entities
         self.has_strings = type(tokens) is _StrTokens
+        #: (index, values of every parameter from that index on) once ``tokens.reals_from``
+        #: parsed them, False when it could not, None before it was asked
+        self.bulk = None
 
     def error(self, message: str, index: int | None = None):
         index = self.i if index is None else index
@@ -455,6 +561,14 @@ class _Params:
     def reals(self, count: int, what: str) -> np.ndarray:
         if count < 0 or count > self.remaining:
             self.error(f"{what}: {count} values needed, {max(self.remaining, 0)} present")
+        if count >= _BULK_MIN and self.bulk is not False and type(self.t) is _Tokens:
+            if self.bulk is None:  # tried once per record, so the work stays linear
+                a = self.t.reals_from(self.i)
+                self.bulk = False if a is None else (self.i, a)
+            if self.bulk and self.i >= self.bulk[0]:
+                k = self.i - self.bulk[0]
+                self.i += count
+                return self.bulk[1][k : k + count].copy()
         toks = self.t[self.i : self.i + count]
         try:
             if self.has_strings and any(isinstance(t, _Str) for t in toks):
