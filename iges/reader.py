@@ -51,6 +51,8 @@ _DIGITS = re.compile(r"[0-9]{1,12}")
 _REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
 #: The characters an IGES real is written with (and the parameter delimiter between them).
 _REAL_CHARS = b"0123456789+-.EeDd, "
+#: The same without the Fortran exponent letters: text that numpy reads as it is.
+_PLAIN_CHARS = b"0123456789+-.Ee, "
 _HOLLERITH = re.compile(r" *([0-9]{1,9})H")
 
 
@@ -78,10 +80,11 @@ class _Tokens:
     parameter from an index to the end with one numpy call, so a B-spline's thousands of
     knots, weights and coordinates never become Python strings."""
 
-    __slots__ = ("body", "pd", "n", "head", "tail", "offsets", "_all")
+    __slots__ = ("body", "pd", "plain", "n", "head", "tail", "offsets", "_all")
 
-    def __init__(self, body: str, pd: str):
-        self.body, self.pd, self._all = body, pd, None
+    def __init__(self, body: str, pd: str, plain: bool = False):
+        # plain: the body is known to hold only the characters of _PLAIN_CHARS
+        self.body, self.pd, self.plain, self._all = body, pd, plain, None
         head = body.split(pd, _ENDS)
         if len(head) <= _ENDS:  # short record: everything is split already
             self.n, self.head, self.tail = len(head), head, []
@@ -135,24 +138,29 @@ class _Tokens:
         and names the bad one). The values are those of ``float`` on each parameter: numpy's
         text parser rounds correctly, and what it would take that ``float`` refuses (a blank
         parameter, ``nan``, any other character) is ruled out before it runs."""
-        out = None
-        if self.pd == "," and i < len(self.offsets):
-            text = self.body[self.offsets[i]:].encode("latin-1", "replace")
-            if not text.translate(None, _REAL_CHARS):
-                compact = text.replace(b" ", b"") if b" " in text else text
-                # an empty or blank parameter is a default (0.0 here), which numpy would misread
-                if compact and b",," not in compact and compact[:1] != b"," and compact[-1:] != b",":
-                    if b"D" in text or b"d" in text:
-                        text = text.replace(b"D", b"E").replace(b"d", b"e")
-                    try:
-                        with warnings.catch_warnings():
-                            warnings.simplefilter("error")  # numpy: "could not be read to its end"
-                            a = np.fromstring(text, dtype=np.float64, sep=",")
-                    except (ValueError, DeprecationWarning):
-                        a = None
-                    if a is not None and a.size == self.n - i and np.all(np.isfinite(a)):
-                        out = a
-        return out
+        if self.pd != "," or i >= len(self.offsets):
+            return None
+        text = self.body[self.offsets[i]:]
+        if not self.plain:  # (plain: checked for the whole section at once, parse_iges)
+            if text.encode("latin-1", "replace").translate(None, _REAL_CHARS):
+                return None
+            if "D" in text or "d" in text:
+                text = text.replace("D", "E").replace("d", "e")
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")  # numpy: "could not be read to its end"
+                a = np.fromstring(text, dtype=np.float64, sep=",")
+        except (ValueError, DeprecationWarning):
+            return None
+        # an empty parameter stops numpy short (fewer values); a blank one is a default (0.0
+        # in reals) that numpy reads as -1.0, so a -1.0 has its parameters looked at
+        if a.size != self.n - i or not np.all(np.isfinite(a)):
+            return None
+        if np.any(a == -1.0):
+            compact = text.replace(" ", "")
+            if not compact or ",," in compact or compact[0] == "," or compact[-1] == ",":
+                return None
+        return a
 
 
 # -- the model -----------------------------------------------------------------------------------
@@ -431,7 +439,8 @@ def _column_integers(f: np.ndarray) -> np.ndarray | None:
 
 
 # -- parameters ----------------------------------------------------------------------------------
-def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of, strip: bool = True) -> list:
+def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of, strip: bool = True,
+              plain: bool = False) -> list:
     """Parameters of one record up to its record delimiter (IGES 5.3 §2.2.3).
 
     ``strip=False``: a record without strings comes back as a lazily split
@@ -443,7 +452,7 @@ def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of, strip: bool = 
             src.error("missing record delimiter", line_of(len(data) - 1))
         body = data[:end]
         if not strip:
-            return _Tokens(body, pd)
+            return _Tokens(body, pd, plain)
         if " " not in body:
             return body.split(pd)
         return [t.strip() for t in body.split(pd)]
@@ -874,11 +883,15 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
     # columns 1-64 of every P line (80 columns each: _sections checks it) and the back
     # pointers of columns 66-72, for slicing records out without a loop per line
     if isinstance(plines, _Rows):
-        pdata = plines.columns(0, 64).tobytes().decode("latin-1")
+        pbytes = plines.columns(0, 64).tobytes()
+        pdata = pbytes.decode("latin-1")
         pback = _column_integers(plines.columns(65, 72))
     else:
         pdata = "".join([text[:64] for _, text in plines])
+        pbytes = pdata.encode("latin-1", "replace")
         pback = None
+    # a section of numbers only (no strings, no D exponents), checked once for all records
+    plain = pd == "," and not pbytes.translate(None, _PLAIN_CHARS + rd.encode("latin-1", "replace"))
     if pback is None:
         pback = [text[65:72] for _, text in plines]
     n = len(dlines) // 2
@@ -966,7 +979,7 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
         def line_of(offset):
             return first_line + min(max(offset, 0) // 64, count - 1)
 
-        tokens = _tokenize(data, pd, rd, src, line_of, strip=False)
+        tokens = _tokenize(data, pd, rd, src, line_of, strip=False, plain=plain)
         if type(tokens) is not _StrTokens and tokens:
             tokens[0] = tokens[0].strip()
 

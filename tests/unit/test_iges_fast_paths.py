@@ -68,6 +68,8 @@ def test_bulk_reals_are_float_of_every_parameter(monkeypatch):
     variants = [
         (x, " " + x + "  "),  # blanks around a parameter
         (x, " "),  # a blank parameter is defaulted (0.0); numpy alone would read -1
+        (x, "   "),
+        (x, "-1.0"),  # a true -1 among the values
         (x, ""),  # an empty one too
         (x, x.replace("e", "D") if "e" in x else x + "D0"),  # Fortran exponent letter
         (x, x.replace("e", "d") if "e" in x else x + "d+00"),
