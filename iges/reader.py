@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import sys
 import warnings
 from dataclasses import dataclass
 
@@ -69,6 +70,22 @@ class _StrTokens(list):
 _ENDS = 16
 #: Runs of reals at least this long are parsed with one numpy call (:meth:`_Params.reals`).
 _BULK_MIN = 16
+
+
+#: numpy's 80-bit x87 extended type (16 bytes, 64-bit significand in the first 8, little
+#: endian), or None where ``np.longdouble`` is something else (double, quad, double-double)
+_EXTENDED = (np.longdouble if np.finfo(np.longdouble).nmant == 63 and np.dtype(np.longdouble).itemsize == 16
+             and sys.byteorder == "little" else None)
+
+
+def _fromstring(text: str, dtype) -> np.ndarray | None:
+    """numpy's parse of comma-separated numbers, or None when it stops short."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # numpy: "could not be read to its end"
+            return np.fromstring(text, dtype=dtype, sep=",")
+    except (ValueError, DeprecationWarning):
+        return None
 
 
 class _Tokens:
@@ -136,8 +153,9 @@ class _Tokens:
         """Parameters i..n-1 as float64 when every one of them is a finite real written with
         the characters of IGES reals only, else None (the caller then reads them one by one
         and names the bad one). The values are those of ``float`` on each parameter: numpy's
-        text parser rounds correctly, and what it would take that ``float`` refuses (a blank
-        parameter, ``nan``, any other character) is ruled out before it runs."""
+        text parser rounds correctly (in double, or in extended precision with the double
+        rounding checked), and what it would take that ``float`` refuses (a blank
+        parameter, ``nan``, any other character) is ruled out."""
         if self.pd != "," or i >= len(self.offsets):
             return None
         text = self.body[self.offsets[i]:]
@@ -146,14 +164,27 @@ class _Tokens:
                 return None
             if "D" in text or "d" in text:
                 text = text.replace("D", "E").replace("d", "e")
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("error")  # numpy: "could not be read to its end"
-                a = np.fromstring(text, dtype=np.float64, sep=",")
-        except (ValueError, DeprecationWarning):
+        if _EXTENDED is None:
+            a = _fromstring(text, np.float64)
+        else:
+            a = _fromstring(text, _EXTENDED)
+            if a is not None:
+                # read in x87 extended precision (the C library's strtold, faster than
+                # Python's strtod) and rounded to double: exact unless the extended value
+                # lies at (or within one unit of) a midpoint between two doubles, where
+                # rounding twice can differ from rounding once; such records, and
+                # subnormals, are read again straight to double
+                mant = a.view(np.uint64)[0::2]  # the 64-bit significand of each value
+                with np.errstate(over="ignore"):  # beyond double: inf, refused below
+                    x = a.astype(np.float64)
+                near_mid = ((mant - np.uint64(0x3FF)) & np.uint64(0x7FF)) <= np.uint64(2)
+                tiny = (np.abs(x) < np.finfo(np.float64).tiny) & (x != 0.0)
+                a = _fromstring(text, np.float64) if np.any(near_mid | tiny) else x
+        if a is None:
             return None
         # an empty parameter stops numpy short (fewer values); a blank one is a default (0.0
-        # in reals) that numpy reads as -1.0, so a -1.0 has its parameters looked at
+        # in reals), which numpy's extended parse reads as 0.0 but its double parse as
+        # -1.0, so a -1.0 has its parameters looked at
         if a.size != self.n - i or not np.all(np.isfinite(a)):
             return None
         if np.any(a == -1.0):

@@ -147,3 +147,35 @@ def test_jittered_triangulation_never_folds_over_close_loop_points(monkeypatch):
     signed = signed * np.sign(signed.sum())
     assert abs(np.abs(signed).sum() - 1.0) < 1e-9
     assert abs(signed.sum() - 1.0) < 1e-9
+
+
+def test_bulk_reals_round_like_float_near_midpoints_and_at_the_ends_of_the_range():
+    """Where numpy reads in x87 extended precision and rounds to double (``_EXTENDED``),
+    rounding twice must give what one correct rounding (``float``) gives: decimals just
+    off the midpoint between two doubles are the cases where it would not."""
+    from decimal import Decimal, localcontext
+
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-1, 1, 3000) * 10.0 ** rng.integers(-30, 30, 3000)
+    records = [
+        ["%.17g" % v for v in x],  # the writer's format: no midpoint is near
+        ["%.6g" % v for v in x] + [repr(v) for v in x] + ["%.3f" % v for v in x[:500]],
+        ["2.2250738585072014e-308", "4.9e-324", "1e-310", "1.7976931348623157e308", "0.0", "-0.0"] * 3,
+    ]
+    def near_midpoints(values):
+        out = []
+        with localcontext() as ctx:
+            ctx.prec = 1200
+            for v in values:
+                d, e = Decimal(float(v)), Decimal(float(np.nextafter(v, np.inf)))
+                mid, step = (d + e) / 2, (e - d) / 2**20  # far below one unit of 64 bits
+                out += [str(mid + step), str(mid - step), str(mid)]
+        return out
+
+    records.append(near_midpoints(x[:400]))
+    # subnormal doubles have fewer bits: their midpoints are not those of normal ones
+    records.append(near_midpoints([1e-310, 2.5e-315, 7.1e-320, 1.5e-323, -3.3e-312, 5e-324]))
+    for tokens in records:
+        a = R._Tokens(",".join(tokens), ",").reals_from(0)
+        ref = np.array([float(t) for t in tokens])
+        assert a is not None and a.tobytes() == ref.tobytes()
