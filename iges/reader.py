@@ -394,7 +394,8 @@ def _fixed_array(data) -> np.ndarray | None:
         a = np.frombuffer(b, dtype=np.uint8).reshape(-1, w)
         # every line ends with ``eol`` and no other CR or LF is in the file
         if (np.all(a[:, 80:] == np.frombuffer(eol, dtype=np.uint8))
-                and b.count(b"\n") == len(a) and b.count(b"\r") == len(a) * (len(eol) - 1)):
+                and b.count(b"\n") == len(a)
+                and (b"\r" not in b if eol == b"\n" else b.count(b"\r") == len(a))):
             return a[:, :80]
     return None
 
