@@ -178,8 +178,10 @@ class _Tokens:
                 with np.errstate(over="ignore"):  # beyond double: inf, refused below
                     x = a.astype(np.float64)
                 near_mid = ((mant - np.uint64(0x3FF)) & np.uint64(0x7FF)) <= np.uint64(2)
-                tiny = (np.abs(x) < np.finfo(np.float64).tiny) & (x != 0.0)
-                a = _fromstring(text, np.float64) if np.any(near_mid | tiny) else x
+                # below the least normal double (including what rounded to zero) unless 0
+                small = np.abs(x) < np.finfo(np.float64).tiny
+                tiny = np.any(small) and np.any(a[small] != 0)
+                a = _fromstring(text, np.float64) if tiny or np.any(near_mid) else x
         if a is None:
             return None
         # an empty parameter stops numpy short (fewer values); a blank one is a default (0.0

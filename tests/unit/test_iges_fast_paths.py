@@ -168,13 +168,14 @@ def test_bulk_reals_round_like_float_near_midpoints_and_at_the_ends_of_the_range
             ctx.prec = 1200
             for v in values:
                 d, e = Decimal(float(v)), Decimal(float(np.nextafter(v, np.inf)))
-                mid, step = (d + e) / 2, (e - d) / 2**20  # far below one unit of 64 bits
+                mid, step = (d + e) / 2, (e - d) / 2**80  # far below one unit of 64 bits
                 out += [str(mid + step), str(mid - step), str(mid)]
         return out
 
     records.append(near_midpoints(x[:400]))
     # subnormal doubles have fewer bits: their midpoints are not those of normal ones
     records.append(near_midpoints([1e-310, 2.5e-315, 7.1e-320, 1.5e-323, -3.3e-312, 5e-324]))
+    records.append(near_midpoints([0.0, -5e-324]))  # rounding to zero or to the least subnormal
     for tokens in records:
         a = R._Tokens(",".join(tokens), ",").reals_from(0)
         ref = np.array([float(t) for t in tokens])
