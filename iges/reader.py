@@ -14,6 +14,8 @@ from __future__ import annotations
 import math
 import os
 import re
+import sys
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,6 +52,8 @@ _DIGITS = re.compile(r"[0-9]{1,12}")
 _REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[EeDd][+-]?[0-9]{1,4})?")
 #: The characters an IGES real is written with (and the parameter delimiter between them).
 _REAL_CHARS = b"0123456789+-.EeDd, "
+#: The same without the Fortran exponent letters: text that numpy reads as it is.
+_PLAIN_CHARS = b"0123456789+-.Ee, "
 _HOLLERITH = re.compile(r" *([0-9]{1,9})H")
 
 
@@ -59,6 +63,137 @@ class _Str(str):
 
 class _StrTokens(list):
     """Parameters of a record in which at least one Hollerith string was read."""
+
+
+#: Parameters of a string-free record split eagerly at each end (integers, pointers and
+#: single reals are read there); the middle, usually a long run of reals, is parsed in bulk.
+_ENDS = 16
+#: Runs of reals at least this long are parsed with one numpy call (:meth:`_Params.reals`).
+_BULK_MIN = 16
+
+
+#: numpy's 80-bit x87 extended type (16 bytes, 64-bit significand in the first 8, little
+#: endian), or None where ``np.longdouble`` is something else (double, quad, double-double)
+_EXTENDED = (np.longdouble if np.finfo(np.longdouble).nmant == 63 and np.dtype(np.longdouble).itemsize == 16
+             and sys.byteorder == "little" else None)
+
+
+def _fromstring(text: str, dtype) -> np.ndarray | None:
+    """numpy's parse of comma-separated numbers, or None when it stops short."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # numpy: "could not be read to its end"
+            return np.fromstring(text, dtype=dtype, sep=",")
+    except (ValueError, DeprecationWarning):
+        return None
+
+
+class _Tokens:
+    """The parameters of a record without strings, split lazily (IGES 5.3 §2.2.3).
+
+    Behaves as the list ``body.split(pd)`` (length, indexing, slicing, iteration) but splits
+    only the first and last :data:`_ENDS` parameters up front; the whole list is built only
+    when something asks for a parameter in the middle. :meth:`reals_from` parses every
+    parameter from an index to the end with one numpy call, so a B-spline's thousands of
+    knots, weights and coordinates never become Python strings."""
+
+    __slots__ = ("body", "pd", "plain", "n", "head", "tail", "offsets", "_all")
+
+    def __init__(self, body: str, pd: str, plain: bool = False):
+        # plain: the body is known to hold only the characters of _PLAIN_CHARS
+        self.body, self.pd, self.plain, self._all = body, pd, plain, None
+        head = body.split(pd, _ENDS)
+        if len(head) <= _ENDS:  # short record: everything is split already
+            self.n, self.head, self.tail = len(head), head, []
+            self._all = head
+        else:
+            self.n = body.count(pd) + 1
+            self.head = head[:_ENDS]
+            self.tail = body.rsplit(pd, _ENDS)[1:] if self.n > 2 * _ENDS else self.all()[_ENDS:]
+        # character offset of parameter k (k <= _ENDS) in ``body``, for the bulk parse
+        offsets = [0]
+        for t in self.head[:_ENDS]:
+            offsets.append(offsets[-1] + len(t) + 1)
+        self.offsets = offsets
+
+    def all(self) -> list:
+        if self._all is None:
+            self._all = self.body.split(self.pd)
+            self._all[0] = self.head[0]
+        return self._all
+
+    def __len__(self):
+        return self.n
+
+    def __bool__(self):
+        return self.n > 0
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return self.all()[k]
+        if k < 0:
+            k += self.n
+        if 0 <= k < len(self.head):
+            return self.head[k]
+        if self.n - len(self.tail) <= k < self.n:
+            return self.tail[k - self.n + len(self.tail)]
+        return self.all()[k]
+
+    def __setitem__(self, k, value):
+        if k != 0:
+            raise IndexError("only the entity type parameter is replaced")
+        self.head[0] = value
+        if self._all is not None:
+            self._all[0] = value
+
+    def __iter__(self):
+        return iter(self.all())
+
+    def reals_from(self, i: int) -> np.ndarray | None:
+        """Parameters i..n-1 as float64 when every one of them is a finite real written with
+        the characters of IGES reals only, else None (the caller then reads them one by one
+        and names the bad one). The values are those of ``float`` on each parameter: numpy's
+        text parser rounds correctly (in double, or in extended precision with the double
+        rounding checked), and what it would take that ``float`` refuses (a blank
+        parameter, ``nan``, any other character) is ruled out."""
+        if self.pd != "," or i >= len(self.offsets):
+            return None
+        text = self.body[self.offsets[i]:]
+        if not self.plain:  # (plain: checked for the whole section at once, parse_iges)
+            if text.encode("latin-1", "replace").translate(None, _REAL_CHARS):
+                return None
+            if "D" in text or "d" in text:
+                text = text.replace("D", "E").replace("d", "e")
+        if _EXTENDED is None:
+            a = _fromstring(text, np.float64)
+        else:
+            a = _fromstring(text, _EXTENDED)
+            if a is not None:
+                # read in x87 extended precision (the C library's strtold, faster than
+                # Python's strtod) and rounded to double: exact unless the extended value
+                # lies at (or within one unit of) a midpoint between two doubles, where
+                # rounding twice can differ from rounding once; such records, and
+                # subnormals, are read again straight to double
+                mant = a.view(np.uint64)[0::2]  # the 64-bit significand of each value
+                with np.errstate(over="ignore"):  # beyond double: inf, refused below
+                    x = a.astype(np.float64)
+                near_mid = ((mant - np.uint64(0x3FF)) & np.uint64(0x7FF)) <= np.uint64(2)
+                # below the least normal double (including what rounded to zero) unless 0
+                small = np.abs(x) < np.finfo(np.float64).tiny
+                tiny = np.any(small) and np.any(a[small] != 0)
+                a = _fromstring(text, np.float64) if tiny or np.any(near_mid) else x
+        if a is None:
+            return None
+        # an empty parameter stops numpy short (fewer values); a blank one is a default (0.0
+        # in reals), which numpy's extended parse reads as 0.0 but its double parse as
+        # -1.0, so a -1.0 has its parameters looked at
+        if a.size != self.n - i or not np.all(np.isfinite(a)):
+            return None
+        if np.any(a == -1.0):
+            compact = text.replace(" ", "")
+            if not compact or ",," in compact or compact[0] == "," or compact[-1] == ",":
+                return None
+        return a
 
 
 # -- the model -----------------------------------------------------------------------------------
@@ -261,7 +396,8 @@ def _fixed_array(data) -> np.ndarray | None:
         a = np.frombuffer(b, dtype=np.uint8).reshape(-1, w)
         # every line ends with ``eol`` and no other CR or LF is in the file
         if (np.all(a[:, 80:] == np.frombuffer(eol, dtype=np.uint8))
-                and b.count(b"\n") == len(a) and b.count(b"\r") == len(a) * (len(eol) - 1)):
+                and b.count(b"\n") == len(a)
+                and (b"\r" not in b if eol == b"\n" else b.count(b"\r") == len(a))):
             return a[:, :80]
     return None
 
@@ -317,31 +453,41 @@ def _sections_fast(lines):
 
 def _column_integers(f: np.ndarray) -> np.ndarray | None:
     """Right-justified unsigned integers in columns of a uint8 array (one per row, leading
-    blanks, at least the last column a digit); None when any row is not such a number."""
+    blanks, at least the last column a digit); None when any row is not such a number.
+
+    Column by column (a handful of passes over the rows, no (rows, columns) temporaries
+    beyond the digit mask): this runs on every sequence number and back pointer of a file."""
     d = f - np.uint8(48)  # digits 0..9; a blank wraps to 240
     digit = d <= 9
     if not np.all(digit | (f == 32)) or not np.all(digit[:, -1]):
         return None
-    # blanks may only lead: once a digit is seen, no blank follows
-    if np.any(~digit[:, 1:] & np.maximum.accumulate(digit, axis=1)[:, :-1]):
+    # blanks may only lead: no digit is followed by a blank
+    if np.any(digit[:, :-1] > digit[:, 1:]):
         return None
     d[~digit] = 0
-    return d.astype(np.int64) @ (10 ** np.arange(f.shape[1] - 1, -1, -1, dtype=np.int64))
+    value = d[:, 0].astype(np.int64)
+    for k in range(1, f.shape[1]):
+        value *= 10
+        value += d[:, k]
+    return value
 
 
 # -- parameters ----------------------------------------------------------------------------------
-def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of, strip: bool = True) -> list:
+def _tokenize(data: str, pd: str, rd: str, src: _Source, line_of, strip: bool = True,
+              plain: bool = False) -> list:
     """Parameters of one record up to its record delimiter (IGES 5.3 §2.2.3).
 
-    ``strip=False``: a record without strings comes back as a plain list whose tokens
-    may keep blanks around them (:class:`_Params` strips what it reads one by one, and
-    reads runs of reals without stripping them), which saves a pass over every token."""
+    ``strip=False``: a record without strings comes back as a lazily split
+    :class:`_Tokens` whose tokens may keep blanks around them (:class:`_Params` strips what
+    it reads one by one, and reads runs of reals in bulk without splitting them)."""
     if "H" not in data:
         end = data.find(rd)
         if end < 0:
             src.error("missing record delimiter", line_of(len(data) - 1))
         body = data[:end]
-        if " " not in body or not strip:
+        if not strip:
+            return _Tokens(body, pd, plain)
+        if " " not in body:
             return body.split(pd)
         return [t.strip() for t in body.split(pd)]
     out = _StrTokens()
@@ -409,6 +555,9 @@ class _Params:
         self.line_of_index = line_of_index
         self.n_entities = n_entities
         self.has_strings = type(tokens) is _StrTokens
+        #: (index, values of every parameter from that index on) once ``tokens.reals_from``
+        #: parsed them, False when it could not, None before it was asked
+        self.bulk = None
 
     def error(self, message: str, index: int | None = None):
         index = self.i if index is None else index
@@ -455,6 +604,14 @@ class _Params:
     def reals(self, count: int, what: str) -> np.ndarray:
         if count < 0 or count > self.remaining:
             self.error(f"{what}: {count} values needed, {max(self.remaining, 0)} present")
+        if count >= _BULK_MIN and self.bulk is not False and type(self.t) is _Tokens:
+            if self.bulk is None:  # tried once per record, so the work stays linear
+                a = self.t.reals_from(self.i)
+                self.bulk = False if a is None else (self.i, a)
+            if self.bulk and self.i >= self.bulk[0]:
+                k = self.i - self.bulk[0]
+                self.i += count
+                return self.bulk[1][k : k + count].copy()
         toks = self.t[self.i : self.i + count]
         try:
             if self.has_strings and any(isinstance(t, _Str) for t in toks):
@@ -760,11 +917,15 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
     # columns 1-64 of every P line (80 columns each: _sections checks it) and the back
     # pointers of columns 66-72, for slicing records out without a loop per line
     if isinstance(plines, _Rows):
-        pdata = plines.columns(0, 64).tobytes().decode("latin-1")
+        pbytes = plines.columns(0, 64).tobytes()
+        pdata = pbytes.decode("latin-1")
         pback = _column_integers(plines.columns(65, 72))
     else:
         pdata = "".join([text[:64] for _, text in plines])
+        pbytes = pdata.encode("latin-1", "replace")
         pback = None
+    # a section of numbers only (no strings, no D exponents), checked once for all records
+    plain = pd == "," and not pbytes.translate(None, _PLAIN_CHARS + rd.encode("latin-1", "replace"))
     if pback is None:
         pback = [text[65:72] for _, text in plines]
     n = len(dlines) // 2
@@ -852,7 +1013,7 @@ def parse_iges(data, path=None, *, strict: bool = True) -> IgesModel:
         def line_of(offset):
             return first_line + min(max(offset, 0) // 64, count - 1)
 
-        tokens = _tokenize(data, pd, rd, src, line_of, strip=False)
+        tokens = _tokenize(data, pd, rd, src, line_of, strip=False, plain=plain)
         if type(tokens) is not _StrTokens and tokens:
             tokens[0] = tokens[0].strip()
 

@@ -33,9 +33,10 @@ SLIVER_AREA = 1e-12
 MIN_STRETCH = 1e-3
 #: Most vertices of one face's display mesh (a tolerance missed at this size is reported).
 MAX_FACE_POINTS = 20_000
-#: Edges processed at once by the point-in-polygon test (bounds the memory to
-#: points x this many booleans).
-EDGE_CHUNK = 256
+#: Points are moved by at most this fraction of a grid cell for Qhull only (see tessellate).
+JITTER = 1e-9
+#: (point, edge) crossings formed at once by the point-in-polygon test (bounds its memory).
+PAIR_CHUNK = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -53,8 +54,11 @@ def inside(points: np.ndarray, loops: list) -> np.ndarray:
     """Even-odd rule: True where ``points`` (k, 2) lie inside the region bounded by the
     closed polylines ``loops`` (each (m, 2), last point joined to the first).
 
-    Points and edges are bucketed in horizontal bands (about sqrt(edges) of them), so each
-    point is tested only against the edges that span its band."""
+    A point lies inside when an odd number of edges cross the ray from it in +x: edges with
+    ylo <= y < yhi whose crossing abscissa is beyond the point. With the points sorted by y,
+    each edge finds the points of its y-range by binary search, so only the (point, edge)
+    pairs that do cross are formed (in chunks of :data:`PAIR_CHUNK`): the work is the
+    number of crossings, not points x edges."""
     points = np.asarray(points, dtype=np.float64)
     odd = np.zeros(len(points), dtype=bool)
     if not len(points):
@@ -64,30 +68,44 @@ def inside(points: np.ndarray, loops: list) -> np.ndarray:
     ylo, yhi = np.minimum(A[:, 1], B[:, 1]), np.maximum(A[:, 1], B[:, 1])
     keep = yhi > ylo  # horizontal edges never cross a horizontal ray
     A, B, ylo, yhi = A[keep], B[keep], ylo[keep], yhi[keep]
+    if not len(A):
+        return odd
+    slope = (B[:, 0] - A[:, 0]) / (B[:, 1] - A[:, 1])
     py = points[:, 1]
-    lo, hi = float(py.min()), float(py.max())
-    nb = max(1, int(np.sqrt(len(A))))
-    width = (hi - lo) / nb or 1.0
-    band = np.clip(((py - lo) / width).astype(np.int64), 0, nb - 1)
-    order = np.argsort(band, kind="stable")
-    starts = np.searchsorted(band[order], np.arange(nb + 1))
-    first = np.clip(np.floor((ylo - lo) / width).astype(np.int64), 0, nb - 1)
-    last = np.clip(np.floor((yhi - lo) / width).astype(np.int64), 0, nb - 1)
-    for k in range(nb):
-        idx = order[starts[k] : starts[k + 1]]
-        if not len(idx):
-            continue
-        e = np.nonzero((first <= k) & (last >= k))[0]
-        if not len(e):
-            continue
-        px, pyk = points[idx, 0], py[idx]
-        for s in range(0, len(e), EDGE_CHUNK):
-            ee = e[s : s + EDGE_CHUNK]
-            x1, y1, x2, y2 = A[ee, 0], A[ee, 1], B[ee, 0], B[ee, 1]
-            cross = (y1[None, :] > pyk[:, None]) != (y2[None, :] > pyk[:, None])
-            xint = x1[None, :] + (pyk[:, None] - y1[None, :]) * ((x2 - x1) / (y2 - y1))[None, :]
-            odd[idx] ^= (np.count_nonzero(cross & (px[:, None] < xint), axis=1) % 2).astype(bool)
+    order = np.argsort(py, kind="stable")
+    ys = py[order]
+    first = np.searchsorted(ys, ylo, side="left")  # points with ylo <= y < yhi
+    count = np.searchsorted(ys, yhi, side="left") - first
+    ends = np.cumsum(count)
+    parity = np.zeros(len(points), dtype=np.int64)
+    e0 = 0
+    while e0 < len(A):
+        # the edges e0..e1-1 make at most PAIR_CHUNK pairs (at least one edge)
+        base = ends[e0 - 1] if e0 else 0
+        e1 = max(e0 + 1, int(np.searchsorted(ends, base + PAIR_CHUNK, side="right")))
+        c = count[e0:e1]
+        n = int(c.sum())
+        if n:
+            edge = np.repeat(np.arange(e0, e1), c)
+            rank = np.repeat(first[e0:e1] - (np.cumsum(c) - c), c) + np.arange(n)
+            pt = order[rank]
+            xint = A[edge, 0] + (py[pt] - A[edge, 1]) * slope[edge]
+            parity += np.bincount(pt[points[pt, 0] < xint], minlength=len(points))
+        e0 = e1
+    odd[:] = parity % 2 == 1
     return odd
+
+
+def _flipped(P: np.ndarray, Q: np.ndarray, tri: np.ndarray, sliver: float) -> np.ndarray:
+    """Triangles ``tri`` whose orientation differs between the vertex sets P and Q, among
+    those of (doubled) area above ``sliver`` in P."""
+
+    def doubled_area(X):
+        e1, e2 = X[tri[:, 1]] - X[tri[:, 0]], X[tri[:, 2]] - X[tri[:, 0]]
+        return e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+
+    a = doubled_area(P)
+    return (np.abs(a) > sliver) & (np.sign(a) != np.sign(doubled_area(Q)))
 
 
 def _resample(loop: np.ndarray, step: float, max_points: int) -> np.ndarray:
@@ -97,8 +115,10 @@ def _resample(loop: np.ndarray, step: float, max_points: int) -> np.ndarray:
     k = np.maximum(1, np.ceil(np.minimum(seg / step, max_points)).astype(np.int64))
     if int(k.sum()) > max_points:
         raise IgesError(f"meshing the trimmed face needs more than the budget of {max_points} points")
-    out = [loop[i] + (b[i] - loop[i]) * (np.arange(k[i])[:, None] / k[i]) for i in range(len(loop))]
-    return np.concatenate(out)
+    # segment i gives loop[i] + (b[i] - loop[i]) * j / k[i], j = 0 .. k[i] - 1 (all at once)
+    seg_of = np.repeat(np.arange(len(loop)), k)
+    j = np.arange(len(seg_of)) - np.repeat(np.cumsum(k) - k, k)
+    return loop[seg_of] + (b - loop)[seg_of] * (j / k[seg_of])[:, None]
 
 
 def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> TrimmedMesh:
@@ -148,29 +168,44 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
         raise IgesError(f"meshing the trimmed face needs more than the budget of {max_points} points")
     X = evaluate(*(P / scale + lo).T)
     floor = MIN_SPACING * h * START_CELLS
-    weights = (np.array([1, 1, 1]) / 3, np.array([0.5, 0.5, 0]), np.array([0, 0.5, 0.5]), np.array([0.5, 0, 0.5]))
+    # Qhull is given the points moved by a fixed pseudo-random fraction JITTER of a cell:
+    # the regular grid's four co-circular points per cell make it merge and re-triangulate
+    # facets (two to three times slower). The triangles are a valid mesh of the unmoved
+    # points when none of non-negligible area changes orientation; loop points closer
+    # together than the jitter can make one flip, and that round is triangulated unmoved.
+    jitter = np.random.default_rng(0).uniform(-JITTER * h, JITTER * h, size=P.shape)
+    sliver = SLIVER_AREA * float(width.max()) ** 2
     for _ in range(MAX_ROUNDS):
         try:
-            tri = Delaunay(P).simplices
+            tri = Delaunay(P + jitter).simplices
+            if np.any(_flipped(P, P + jitter, tri, sliver)):
+                tri = Delaunay(P).simplices
         except QhullError:  # degenerate: all loop points on a line
             raise IgesError("the trimming loops are degenerate (all points on a line)") from None
-        tri = tri[inside(P[tri].mean(axis=1), mloops)]
+        centroids = P[tri].mean(axis=1)
+        kept = inside(centroids, mloops)
+        tri, centroids = tri[kept], centroids[kept]
         # Qhull leaves slivers of (almost) zero area along straight runs of loop points:
         # they show nothing and their chords are not part of the surface
         e1, e2 = P[tri[:, 1]] - P[tri[:, 0]], P[tri[:, 2]] - P[tri[:, 0]]
-        tri = tri[np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) > SLIVER_AREA * float(width.max()) ** 2]
+        big = np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) > sliver
+        tri, centroids = tri[big], centroids[big]
         if not len(tri):
             raise IgesError("the trimming loops bound no area")
         if not np.all(np.isfinite(X)):
             raise IgesError("the surface is not finite over its trimming loops")
-        # chordal deviation at centroids and edge midpoints
-        probes = np.concatenate([np.einsum("k,mkd->md", w, P[tri]) for w in weights])
-        linear = np.concatenate([np.einsum("k,mkd->md", w, X[tri]) for w in weights])
+        # chordal deviation at centroids (inside the region: the triangles were kept for
+        # it) and at the midpoint of every edge, each edge once although two triangles share it
+        edges = np.sort(tri[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+        edges = edges[np.unique(edges[:, 0] * len(P) + edges[:, 1], return_index=True)[1]]
+        mids = 0.5 * (P[edges[:, 0]] + P[edges[:, 1]])
+        probes = np.concatenate([centroids, mids])
+        linear = np.concatenate([X[tri].mean(axis=1), 0.5 * (X[edges[:, 0]] + X[edges[:, 1]])])
         Xp = evaluate(*(probes / scale + lo).T)
         dev = np.linalg.norm(Xp - linear, axis=1)
-        # probes outside the region (edges of triangles over a concave part of a loop)
+        # midpoints outside the region (edges of triangles over a concave part of a loop)
         # evaluate the surface where the face is not: they do not count
-        dev[~inside(probes, mloops)] = 0.0
+        dev[len(centroids):][~inside(mids, mloops)] = 0.0
         deviation = float(dev.max()) if dev.size else 0.0
         best = TrimmedMesh(X, tri.astype(np.int64), P / scale + lo, deviation)
         bad = dev > tolerance
@@ -188,6 +223,7 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
             break
         P = np.concatenate([P, cand])
         X = np.concatenate([X, cx])
+        jitter = np.concatenate([jitter, np.random.default_rng(len(P)).uniform(-JITTER * h, JITTER * h, size=cand.shape)])
     if best is None:
         raise IgesError(f"meshing the trimmed face within budget of {max_points} points is not possible")
     return best
