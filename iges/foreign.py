@@ -859,7 +859,7 @@ def _mesh_face(imp, record, surface, loops, place, name, exact=None):
     note = "" if exact is not None else "shown trimmed; no exact export for this face"
     if mesh.deviation > imp.tolerance * size:
         note = (f"mesh deviates {mesh.deviation:.3g} m from the surface, more than the display "
-                f"tolerance {imp.tolerance * size:.3g} m (point budget reached)")
+                f"tolerance {imp.tolerance * size:.3g} m (refinement stopped: {mesh.stopped or 'budget'})")
         imp.notes.append(f"{name}: {note}")
     imp.items.append(ImportItem(name, "mesh", mesh=mesh, exact=exact, note=note))
 

@@ -48,6 +48,8 @@ class TrimmedMesh:
     triangles: np.ndarray
     uv: np.ndarray
     deviation: float
+    #: why refinement stopped short of the tolerance ("" when it did not)
+    stopped: str = ""
 
 
 def inside(points: np.ndarray, loops: list) -> np.ndarray:
@@ -121,6 +123,61 @@ def _resample(loop: np.ndarray, step: float, max_points: int) -> np.ndarray:
     return loop[seg_of] + (b - loop)[seg_of] * (j / k[seg_of])[:, None]
 
 
+#: Loop points are thinned to this fraction of the display tolerance (:func:`_thin`).
+THIN_FRACTION = 0.1
+#: Rounds of :func:`_thin` before every point still off its chord is kept.
+THIN_ROUNDS = 64
+
+
+def _thin(evaluate, uv: np.ndarray, points: np.ndarray, tol: float) -> np.ndarray:
+    """Indices (ascending) of the points of a closed trimming loop to keep: ``uv`` (m, 2) in
+    the parameter plane, ``points`` (m, 3) = S(uv). Douglas–Peucker (Ramer 1972; Douglas &
+    Peucker 1973), run on all chords at once, each round adding the farthest point of every
+    chord that misses. A dropped point misses when it lies farther than ``tol`` from the 3-D
+    chord AB between the kept points on either side, or when the surface at the (u, v)
+    chord's point a + s (b - a) lies farther than ``tol`` from A + s (B - A), s being the
+    point's place between the two by index (so that the surface is probed all along the
+    chord even where the dropped points gather in 3-D, as on an edge collapsed to a pole):
+    the mesh's boundary edge must be near both the loop and the surface next to it.
+
+    A trimming loop sampled per knot span of long, many-span curves (a blade root edge) can
+    hold thousands of points within the display tolerance of a few chords; as mesh
+    vertices they spent the face's point budget before the inside was refined."""
+    m = len(points)
+    if m <= 8 or not tol > 0:
+        return np.arange(m)
+    P = np.concatenate([points, points[:1]])  # closed: point m is point 0
+    UV = np.concatenate([uv, uv[:1]])
+    keep = np.zeros(m + 1, dtype=bool)
+    keep[[0, m // 3, (2 * m) // 3, m]] = True
+    at = np.arange(m + 1)
+    for _ in range(THIN_ROUNDS):
+        idx = np.nonzero(keep)[0]
+        seg = np.minimum(np.searchsorted(idx, at, side="right") - 1, len(idx) - 2)
+        a, b = P[idx[seg]], P[idx[seg + 1]]
+        ab = b - a
+        L2 = np.einsum("ij,ij->i", ab, ab)
+        t = np.clip(np.einsum("ij,ij->i", P - a, ab) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
+        foot = a + t[:, None] * ab
+        d = np.linalg.norm(P - foot, axis=1)
+        free = ~keep
+        i0, i1 = idx[seg[free]], idx[seg[free] + 1]
+        s_ = ((at[free] - i0) / (i1 - i0))[:, None]  # by index: spread along the chord
+        w = UV[i0] + s_ * (UV[i1] - UV[i0])
+        on_surface = evaluate(w[:, 0], w[:, 1])
+        d[free] = np.maximum(d[free], np.linalg.norm(on_surface - (P[i0] + s_ * (P[i1] - P[i0])), axis=1))
+        d[~np.isfinite(d)] = np.inf
+        d[keep] = 0.0
+        far = d > tol
+        if not far.any():
+            return np.nonzero(keep[:m])[0]
+        order = np.lexsort((-d, seg))  # by chord, farthest first
+        first = order[np.r_[True, seg[order][1:] != seg[order][:-1]]]
+        keep[first[far[first]]] = True
+    keep[:m] |= far[:m]  # rounds spent: keep every point still off its chord
+    return np.nonzero(keep[:m])[0]
+
+
 def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> TrimmedMesh:
     """Mesh of the region of the surface ``evaluate(u, v) -> (..., 3)`` bounded by
     ``loops_uv`` (first the outer loop, then holes; each a closed polyline (m, 2) in the
@@ -131,6 +188,14 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
     loops_uv = [np.asarray(l, dtype=np.float64) for l in loops_uv if len(l) >= 3]
     if not loops_uv:
         raise IgesError("the trimming loops bound no area")
+    # loops hold the points needed within THIN_FRACTION of the tolerance, no more
+    thinned = []
+    for l in loops_uv:
+        Xl = evaluate(l[:, 0], l[:, 1])
+        if np.all(np.isfinite(Xl)):
+            l = l[_thin(evaluate, l, Xl, THIN_FRACTION * tolerance)]
+        thinned.append(l)
+    loops_uv = thinned
     outer = loops_uv[0]
     lo, hi = outer.min(axis=0), outer.max(axis=0)
     span = hi - lo
@@ -207,19 +272,37 @@ def tessellate(evaluate, loops_uv: list, tolerance: float, max_points: int) -> T
         # evaluate the surface where the face is not: they do not count
         dev[len(centroids):][~inside(mids, mloops)] = 0.0
         deviation = float(dev.max()) if dev.size else 0.0
-        best = TrimmedMesh(X, tri.astype(np.int64), P / scale + lo, deviation)
+        best = TrimmedMesh(X, tri.astype(np.int64), P / scale + lo, deviation, f"{MAX_ROUNDS} refinement rounds")
         bad = dev > tolerance
         if not bad.any():
+            best = TrimmedMesh(X, tri.astype(np.int64), P / scale + lo, deviation)
             break
         # refine where the mesh misses: the failing probe points become vertices, but not
         # nearer than ``floor`` to a vertex (nearly coincident points stall Qhull, and a
         # miss that survives at that spacing is a singular spot, reported by ``deviation``)
         cand, cx = probes[bad], Xp[bad]
+        # a failing triangle long in one direction (near a pole, or across a thinned loop)
+        # is split at the midpoint of its longest edge, not at its centroid: the centroid's
+        # three triangles keep that edge, and the next centroid creeps towards it
+        tb = np.nonzero(bad[:len(centroids)])[0]
+        if len(tb):
+            corners3 = P[tri[tb]]
+            lengths = np.linalg.norm(corners3[:, [1, 2, 0]] - corners3, axis=2)
+            k = np.argmax(lengths, axis=1)
+            mid = 0.5 * (corners3[np.arange(len(tb)), k] + corners3[np.arange(len(tb)), (k + 1) % 3])
+            ok = inside(mid, mloops)
+            if ok.any():
+                mid = mid[ok]
+                cand = np.concatenate([cand, mid])
+                cx = np.concatenate([cx, evaluate(*(mid / scale + lo).T)])
         keep = cKDTree(P).query(cand)[0] > floor
         cand, cx = cand[keep], cx[keep]
         _, k = np.unique(np.round(cand / floor), axis=0, return_index=True)
         cand, cx = cand[k], cx[k]
         if not len(cand) or len(P) + len(cand) > max_points:
+            why = (f"point budget of {max_points}" if len(cand) else
+                   "no point to add farther than the minimum spacing from the others")
+            best = TrimmedMesh(best.vertices, best.triangles, best.uv, best.deviation, why)
             break
         P = np.concatenate([P, cand])
         X = np.concatenate([X, cx])

@@ -251,3 +251,30 @@ def test_units_of_default_is_inches():
     text = C.set_global(C.line_file(), unit_flag=None, unit_name=None)
     assert units_of(parse_iges(text, strict=False)).metres_per_unit == 0.0254
     assert math.isclose(units_of(parse_iges(C.line_file(), strict=False)).factor, 1.0)
+
+
+def test_dense_trimming_loop_is_thinned_within_the_tolerance():
+    """A hole loop sampled 5000 times on a cylinder keeps a few dozen points, and every
+    dropped point lies within the thinning tolerance of the mesh's boundary chord."""
+    from bladesmith.iges.tessellate import _thin
+
+    R = 0.05
+
+    def evaluate(u, v):
+        u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
+        return np.stack([R * np.cos(u), R * np.sin(u), v], axis=-1)
+
+    t = np.linspace(0.0, 2.0 * np.pi, 5000, endpoint=False)
+    uv = np.stack([np.pi + 0.5 * np.cos(t), 0.05 + 0.02 * np.sin(t)], axis=1)
+    X = evaluate(uv[:, 0], uv[:, 1])
+    tol = 1e-5
+    keep = _thin(evaluate, uv, X, tol)
+    assert 8 < len(keep) < 300, len(keep)
+    # every dropped point within tol of the chord between its kept neighbours
+    k = np.r_[keep, keep[0] + len(X)]
+    Xc = np.concatenate([X, X])
+    for a, b in zip(k[:-1], k[1:]):
+        A, B = Xc[a], Xc[b]
+        P = Xc[a + 1:b]
+        s = np.clip((P - A) @ (B - A) / ((B - A) @ (B - A)), 0.0, 1.0)
+        assert np.linalg.norm(P - A - s[:, None] * (B - A), axis=1).max(initial=0.0) <= tol
