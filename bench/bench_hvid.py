@@ -1,7 +1,7 @@
 """Hvid (1993) smoothfoil on fx66-s-196 with the paper's jobcard (issue 6: under 50 ms for
 a 180-point airfoil). Baselines measured in the same run: one evaluation of the curvature
 plot of the unsmoothed curve, and the whole run with the deviation report measured the
-pre-issue-22c way (the general closest-point search, one curve per call, for each of
+way before issue 22 (second round) (the general closest-point search, one curve per call, for each of
 the report's three sets of points); the two reports must agree."""
 from contextlib import contextmanager
 
@@ -14,7 +14,7 @@ GOAL_MS = 5.0
 
 
 def _old_deviation(smoothed, unsmoothed, params, data, measure=True, data_params=None):
-    """The deviation report as computed before issue 22c (kept here as the baseline)."""
+    """The deviation report as computed before issue 22's second round (kept here as the baseline)."""
     import numpy as np
     from bladesmith.geometry.fairing import hvid
     from bladesmith.geometry.nurbs import closest_point_curve
@@ -72,7 +72,7 @@ def figures() -> list[dict]:
     r = measure()
     return [{"figure": "Hvid smoothfoil with the deviation report (fx66-s-196, 180 points)",
              "value": r["full"] * 1e3, "unit": "ms",
-             "baseline": f"{r['old'] * 1e3:.1f} ms with the pre-22c report (general closest-point search); "
+             "baseline": f"{r['old'] * 1e3:.1f} ms with the previous report (general closest-point search per curve); "
                          f"{r['smooth'] * 1e3:.1f} ms without the report; one curvature plot "
                          f"{r['base'] * 1e3:.1f} ms; same run",
              "goal": f"<= {GOAL_MS:g} ms"}]
@@ -88,7 +88,7 @@ def main() -> None:
             ("smoothfoil (no deviation measure)", smooth, f"{smooth / base:.1f}x baseline"),
             ("smoothfoil + true deviation", full, f"{full / base:.1f}x baseline; goal <= {GOAL_MS:g} ms "
                                                   "(the whole run, report included)"),
-            ("  with the pre-22c report (baseline)", old, f"now {full / old:.2f}x of it; report alone "
+            ("  with the previous report (baseline)", old, f"now {full / old:.2f}x of it; report alone "
                                                           f"{(full - smooth) * 1e3:.1f} ms against "
                                                           f"{(old - smooth) * 1e3:.1f} ms"),
         ],
