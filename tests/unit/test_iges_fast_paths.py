@@ -149,10 +149,14 @@ def test_jittered_triangulation_never_folds_over_close_loop_points(monkeypatch):
     assert abs(signed.sum() - 1.0) < 1e-9
 
 
-def test_bulk_reals_round_like_float_near_midpoints_and_at_the_ends_of_the_range():
+@pytest.mark.parametrize("extended", ["native", "none"])
+def test_bulk_reals_round_like_float_near_midpoints_and_at_the_ends_of_the_range(extended, monkeypatch):
     """Where numpy reads in x87 extended precision and rounds to double (``_EXTENDED``),
     rounding twice must give what one correct rounding (``float``) gives: decimals just
-    off the midpoint between two doubles are the cases where it would not."""
+    off the midpoint between two doubles are the cases where it would not. "none" runs
+    the double parse that CPUs without the x87 type (aarch64, Windows) use."""
+    if extended == "none":
+        monkeypatch.setattr(R, "_EXTENDED", None)
     from decimal import Decimal, localcontext
 
     rng = np.random.default_rng(3)
