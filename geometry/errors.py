@@ -5,9 +5,24 @@ is a bug and must surface in tests.
 """
 from __future__ import annotations
 
+import re
+
+#: numpy 2 writes its scalars' repr as ``np.float64(1.5)`` (numpy 1: ``1.5``).
+_NUMPY_SCALAR = re.compile(r"\bnp\.(?:float|int|uint|complex|str|bytes)_?\d*\(([^()]*)\)")
+
+
+def plain_numbers(text: str) -> str:
+    """``text`` with numpy 2's scalar reprs (``np.float64(1.5)``) written as the numbers
+    they are (``1.5``), so a message names the value the same way under every numpy."""
+    return _NUMPY_SCALAR.sub(r"\1", text)
+
 
 class BladesmithError(ValueError):
-    """Base class of every error Bladesmith raises on purpose."""
+    """Base class of every error Bladesmith raises on purpose. Its message names values as
+    plain numbers under numpy 1 and 2 alike (:func:`plain_numbers`)."""
+
+    def __init__(self, *args):
+        super().__init__(*(plain_numbers(a) if isinstance(a, str) else a for a in args))
 
 
 class DefinitionError(BladesmithError):
@@ -19,7 +34,7 @@ class DefinitionError(BladesmithError):
     def __init__(self, message: str, *, path: str | None = None, field: str | None = None):
         self.path = path
         self.field = field
-        self.message = message
+        self.message = plain_numbers(message)
         parts = []
         if path:
             parts.append(str(path))

@@ -106,7 +106,7 @@ def check_parameters(u, knots: np.ndarray, degree: int, what: str = "parameter")
         lo, hi = u.min(), u.max()
         if lo < a - slack or hi > b + slack:
             bad = lo if lo < a - slack else hi
-            raise GeometryError(f"{what} {bad!r} is outside the domain [{a!r}, {b!r}]")
+            raise GeometryError(f"{what} {float(bad)!r} is outside the domain [{float(a)!r}, {float(b)!r}]")
     return np.clip(u, a, b)
 
 

@@ -112,7 +112,7 @@ def _knot_value(U: np.ndarray, p: int, u, what: str) -> float:
     a, b = _domain(U, p)
     u = _snap(U, p, u)
     if not a <= u <= b:
-        raise GeometryError(f"{what} {u!r} is outside the domain [{a!r}, {b!r}]")
+        raise GeometryError(f"{what} {float(u)!r} is outside the domain [{float(a)!r}, {float(b)!r}]")
     return u
 
 
@@ -435,7 +435,7 @@ def _knot_list(U: np.ndarray, p: int, new_knots, what: str) -> np.ndarray:
     outside = (X < a) | (X > b)
     if outside.any():
         bad = int(np.flatnonzero(outside)[0])
-        raise GeometryError(f"{what}[{bad}] = {X[bad]!r} is outside the domain [{a!r}, {b!r}]")
+        raise GeometryError(f"{what}[{bad}] = {float(X[bad])!r} is outside the domain [{float(a)!r}, {float(b)!r}]")
     return np.sort(X)  # snapping can swap values closer than KNOT_TOL
 
 
