@@ -266,5 +266,5 @@ def write_table(spec: SweepSpec, rows: list[dict]) -> None:
     w.writerow(columns)
     for r in rows:
         w.writerow(["" if (isinstance(r[c], float) and math.isnan(r[c])) else
-                    (repr(r[c]) if isinstance(r[c], float) else r[c]) for c in columns])
+                    (repr(float(r[c])) if isinstance(r[c], float) else r[c]) for c in columns])
     atomic_write(spec.output / CSV_FILE, text.getvalue())

@@ -612,7 +612,7 @@ def dumps_toml(data: dict, header: str = "") -> str:
         if isinstance(v, (list, tuple)):
             return "[" + ", ".join(value(x) for x in v) + "]"
         if isinstance(v, float):
-            return repr(v)
+            return repr(float(v))  # numpy 2's float64 repr is 'np.float64(...)'
         return str(v)
 
     lines = [header.rstrip()] if header else []

@@ -74,7 +74,7 @@ def net_csv(net: np.ndarray, u=None, v=None) -> str:
     lines = ["i,j,u,v," + ",".join(names)]
     for i in range(nu):
         for j in range(nv):
-            lines.append(f"{i},{j},{u[i]!r},{v[j]!r}," + ",".join(repr(float(c)) for c in net[i, j]))
+            lines.append(f"{i},{j},{float(u[i])!r},{float(v[j])!r}," + ",".join(repr(float(c)) for c in net[i, j]))
     return "\n".join(lines) + "\n"
 
 

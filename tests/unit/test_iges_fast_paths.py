@@ -163,7 +163,7 @@ def test_bulk_reals_round_like_float_near_midpoints_and_at_the_ends_of_the_range
     x = rng.uniform(-1, 1, 3000) * 10.0 ** rng.integers(-30, 30, 3000)
     records = [
         ["%.17g" % v for v in x],  # the writer's format: no midpoint is near
-        ["%.6g" % v for v in x] + [repr(v) for v in x] + ["%.3f" % v for v in x[:500]],
+        ["%.6g" % v for v in x] + [repr(float(v)) for v in x] + ["%.3f" % v for v in x[:500]],
         ["2.2250738585072014e-308", "4.9e-324", "1e-310", "1.7976931348623157e308", "0.0", "-0.0"] * 3,
     ]
     def near_midpoints(values):
