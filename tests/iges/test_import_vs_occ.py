@@ -72,6 +72,22 @@ def test_placement_matches_opencascade(tmp_path, case):
     assert np.abs(box - occ_box).max() <= tol * diag, (box, occ_box)
 
 
+def _write_brep_iges(shape, path):
+    """``shape`` written by OpenCASCADE as an IGES B-rep solid (186/5xx), in millimetres."""
+    from OCP.IGESControl import IGESControl_Writer
+    from OCP.Interface import Interface_Static
+
+    before = Interface_Static.IVal_s("write.iges.brep.mode")
+    try:
+        Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
+        w = IGESControl_Writer("MM", 1)
+        w.AddShape(shape)
+        w.ComputeModel()
+        assert w.Write(str(path))
+    finally:
+        Interface_Static.SetIVal_s("write.iges.brep.mode", before)
+
+
 def _primitives_brep_iges(path):
     """A box, cylinder, cone to its apex, sphere and torus (placed apart, one rotated),
     written by OpenCASCADE as B-rep solids (186/510 faces on 190-198 surfaces)."""
@@ -80,8 +96,6 @@ def _primitives_brep_iges(path):
     from OCP.BRepPrimAPI import (BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCone, BRepPrimAPI_MakeCylinder,
                                  BRepPrimAPI_MakeSphere, BRepPrimAPI_MakeTorus)
     from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
-    from OCP.IGESControl import IGESControl_Writer
-    from OCP.Interface import Interface_Static
     from OCP.TopoDS import TopoDS_Compound
 
     def at(x, y, z, d=(0, 0, 1)):
@@ -100,15 +114,7 @@ def _primitives_brep_iges(path):
     builder.MakeCompound(comp)
     for s in shapes:
         builder.Add(comp, s)
-    before = Interface_Static.IVal_s("write.iges.brep.mode")
-    try:
-        Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
-        w = IGESControl_Writer("MM", 1)
-        w.AddShape(comp)
-        w.ComputeModel()
-        assert w.Write(str(path))
-    finally:
-        Interface_Static.SetIVal_s("write.iges.brep.mode", before)
+    _write_brep_iges(comp, path)
 
 
 def test_analytic_surfaces_of_a_brep_solid_match_opencascade(tmp_path):
@@ -134,19 +140,18 @@ def test_analytic_surfaces_of_a_brep_solid_match_opencascade(tmp_path):
     props = GProp_GProps()
     BRepGProp.SurfaceProperties_s(r.OneShape(), props)
     occ_area = props.Mass()  # mm^2 (OCC's default unit)
-    ours = 0.0
-    for it in report.items:
-        V, T = it.mesh.vertices, it.mesh.triangles
-        ours += 0.5 * np.linalg.norm(np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]]), axis=1).sum()
+    ours = _mesh_area(report)
     assert abs(ours * 1e6 - occ_area) <= 5e-3 * occ_area, (ours * 1e6, occ_area)
 
 
+def _item_area(item) -> float:
+    """Area of one imported item's display mesh."""
+    V, T = item.mesh.vertices, item.mesh.triangles
+    return 0.5 * np.linalg.norm(np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]]), axis=1).sum()
+
+
 def _mesh_area(report) -> float:
-    out = 0.0
-    for it in report.items:
-        V, T = it.mesh.vertices, it.mesh.triangles
-        out += 0.5 * np.linalg.norm(np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]]), axis=1).sum()
-    return out
+    return sum(_item_area(it) for it in report.items)
 
 
 def test_cylinder_face_with_model_space_loop_matches_opencascade(tmp_path):
@@ -182,8 +187,7 @@ def _bump_face_brep_iges(path):
     the way the loop goes."""
     from OCP.BRep import BRep_Tool
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
-    from OCP.IGESControl import IGESControl_Reader, IGESControl_Writer
-    from OCP.Interface import Interface_Static
+    from OCP.IGESControl import IGESControl_Reader
     from OCP.TopAbs import TopAbs_FACE
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
@@ -206,15 +210,7 @@ def _bump_face_brep_iges(path):
     explorer = TopExp_Explorer(r.OneShape(), TopAbs_FACE)
     surface = BRep_Tool.Surface_s(TopoDS.Face(explorer.Current()))
     face = BRepBuilderAPI_MakeFace(surface, 0.0, 1.0, 0.0, 1.0, 1e-7).Face()
-    before = Interface_Static.IVal_s("write.iges.brep.mode")
-    try:
-        Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
-        w = IGESControl_Writer("MM", 1)
-        w.AddShape(face)
-        w.ComputeModel()
-        assert w.Write(str(path))
-    finally:
-        Interface_Static.SetIVal_s("write.iges.brep.mode", before)
+    _write_brep_iges(face, path)
 
 
 def test_brep_face_loop_with_reversed_edges_matches_opencascade(tmp_path):
@@ -269,12 +265,7 @@ def test_own_full_propeller_solid_imports_with_occs_face_areas(tmp_path):
     the display tolerance (iges.tessellate._thin)."""
     import tomllib
 
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-    from OCP.IGESControl import IGESControl_Reader
-    from OCP.TopAbs import TopAbs_FACE
-    from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
+    from occ_support import face_area, read_with_occ
 
     from bladesmith.geometry.propeller import Propeller, smooth_blade
     from bladesmith.geometry.propeller.hub_sector import hub_sector
@@ -286,20 +277,8 @@ def test_own_full_propeller_solid_imports_with_occs_face_areas(tmp_path):
     path = tmp_path / "dtmb4119_solid.igs"
     write_full_propeller_iges(path, model, blade, hub_sector(model, blade=blade), brep=True)
     report = import_path(path)
-    r = IGESControl_Reader()
-    r.ReadFile(str(path))
-    r.TransferRoots()
-    occ = []
-    explorer = TopExp_Explorer(r.OneShape(), TopAbs_FACE)
-    while explorer.More():
-        props = GProp_GProps()
-        BRepGProp.SurfaceProperties_s(TopoDS.Face(explorer.Current()), props)
-        occ.append(props.Mass() * 1e-6)  # OCC reads in millimetres
-        explorer.Next()
-    ours = []
-    for it in report.items:
-        V, T = it.mesh.vertices, it.mesh.triangles
-        ours.append(0.5 * np.linalg.norm(np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]]), axis=1).sum())
+    occ = [face_area(f) * 1e-6 for f in read_with_occ(path).faces]  # OCC reads in millimetres
+    ours = [_item_area(it) for it in report.items]
     assert len(ours) == len(occ) == 25
     rel = np.abs(np.array(ours) / np.array(occ) - 1.0)
     assert rel.max() <= 5e-3, (int(rel.argmax()), float(rel.max()))
