@@ -22,41 +22,18 @@ import os
 import pathlib
 import shutil
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 
 for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_name, "1")
 
-from common import ROOT, load_checkout, median_time  # noqa: E402
+from common import ROOT, load_checkout, load_commit, median_time  # noqa: E402
 
 #: The main commit before issue 22's second session (pipeline 446 ms quiet there).
 BASELINE_COMMIT = "25a7105"
 REPEAT = 7
 LIVE_REPEAT = 9
-
-
-def _load_baseline(tmp: pathlib.Path):
-    """The package at BASELINE_COMMIT as ``bladesmith_baseline``, or None without git."""
-    if shutil.which("git") is None:
-        return None
-    target = tmp / "baseline"
-    target.mkdir()
-    try:
-        archive = subprocess.run(["git", "-C", str(ROOT), "archive", BASELINE_COMMIT], check=True,
-                                 capture_output=True).stdout
-        subprocess.run(["tar", "-x", "-C", str(target)], input=archive, check=True, capture_output=True)
-    except (subprocess.CalledProcessError, OSError):
-        return None
-    name = "bladesmith_baseline"
-    spec = importlib.util.spec_from_file_location(name, target / "__init__.py",
-                                                  submodule_search_locations=[str(target)])
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return name
 
 
 def _pipeline(package: str, out: str):
@@ -77,7 +54,7 @@ def pipeline_figures() -> list[dict]:
     load_checkout()
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="bench_pipeline_"))
     try:
-        base = _load_baseline(tmp)
+        base = load_commit(BASELINE_COMMIT, tmp, "bladesmith_baseline")
         runs = {"bladesmith": _pipeline("bladesmith", str(tmp / "new.igs"))}
         if base is not None:
             runs[base] = _pipeline(base, str(tmp / "old.igs"))

@@ -18,8 +18,6 @@ import os
 import pathlib
 import shutil
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 
@@ -28,7 +26,7 @@ for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np  # noqa: E402
 
-from common import ROOT, load_checkout, median_time, report  # noqa: E402
+from common import ROOT, load_checkout, load_commit, median_time, report  # noqa: E402
 
 #: main before issue 22's smoothing-core work (session 5).
 BASELINE_COMMIT = "7349c2f"
@@ -66,26 +64,6 @@ def main() -> dict:
     return results
 
 
-def _load_commit(commit: str, tmp: pathlib.Path, name: str):
-    """The package at ``commit`` imported as ``name``, or None without git."""
-    if shutil.which("git") is None:
-        return None
-    target = tmp / name
-    target.mkdir()
-    try:
-        archive = subprocess.run(["git", "-C", str(ROOT), "archive", commit], check=True,
-                                 capture_output=True).stdout
-        subprocess.run(["tar", "-x", "-C", str(target)], input=archive, check=True, capture_output=True)
-    except (subprocess.CalledProcessError, OSError):
-        return None
-    spec = importlib.util.spec_from_file_location(name, target / "__init__.py",
-                                                  submodule_search_locations=[str(target)])
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return name
-
-
 def core_times(case: str = "dtmb4119", repeat: int = CORE_REPEAT) -> dict:
     """Median cold smooth_blade time (s) per package, this checkout and the baseline,
     timed alternately."""
@@ -93,7 +71,7 @@ def core_times(case: str = "dtmb4119", repeat: int = CORE_REPEAT) -> dict:
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="bench_core_"))
     try:
         packages = ["bladesmith"]
-        base = _load_commit(BASELINE_COMMIT, tmp, "bladesmith_core_baseline")
+        base = load_commit(BASELINE_COMMIT, tmp, "bladesmith_core_baseline")
         if base is not None:
             packages.append(base)
         path = ROOT / "data" / "propellers" / f"{case}.toml"

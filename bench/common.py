@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import importlib.util
 import pathlib
+import shutil
 import statistics
+import subprocess
 import sys
 import time
 
@@ -20,6 +22,28 @@ def load_checkout(name: str = "bladesmith"):
         sys.modules[name] = module
         spec.loader.exec_module(module)
     return sys.modules[name]
+
+
+def load_commit(commit: str, tmp: pathlib.Path, name: str):
+    """The package at ``commit`` of this repository, unpacked with ``git archive`` into
+    ``tmp / name`` and imported as ``name`` (a baseline to time in the same run); returns
+    ``name``, or None without git or the commit."""
+    if shutil.which("git") is None:
+        return None
+    target = tmp / name
+    target.mkdir()
+    try:
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", commit], check=True,
+                                 capture_output=True).stdout
+        subprocess.run(["tar", "-x", "-C", str(target)], input=archive, check=True, capture_output=True)
+    except (subprocess.CalledProcessError, OSError):
+        return None
+    spec = importlib.util.spec_from_file_location(name, target / "__init__.py",
+                                                  submodule_search_locations=[str(target)])
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return name
 
 
 def median_time(fn, repeat: int = 5, warmup: int = 1) -> float:
