@@ -249,15 +249,21 @@ class BladeSurface:
         return np.clip(eta, self.eta_min, 1.0)
 
     # -- evaluation -------------------------------------------------------------------
-    def _jets(self, xi, eta, order: int, pure: bool = True):
+    def _angles(self, xi, eta):
+        """(ξ, η, hand, dψ/dξ, ψ) with ξ and η checked: ψ = 2πξ (right hand) or 2π(1 - ξ)
+        (left hand), the chordwise angle both :meth:`_jets` and :meth:`_first_derivatives`
+        start from."""
         xi = np.asarray(xi, dtype=np.float64)
         if np.any(~np.isfinite(xi)):
             raise GeometryError("xi contains NaN or infinite values")
         eta = self._check_eta(eta)
         h = self.hand
-        # ---- chordwise (ξ only); ψ = 2πξ (right hand) or 2π(1 - ξ) (left hand)
-        dpsi = TWO_PI * h
         psi = np.mod(TWO_PI * xi if h > 0 else TWO_PI * (1.0 - xi), TWO_PI)
+        return xi, eta, h, TWO_PI * h, psi
+
+    def _jets(self, xi, eta, order: int, pure: bool = True):
+        # ---- chordwise (ξ only)
+        xi, eta, h, dpsi, psi = self._angles(xi, eta)
         S_tab = self.section.thickness
         d = dpsi if order else 0.0
 
@@ -326,13 +332,7 @@ class BladeSurface:
         out, the same operations in the same order (so the same rounding). The ξ-only
         and η-only factors keep their vanishing partials out of the products, as the jets
         do, so the infinite η-derivatives at a closing tip never meet a zero."""
-        xi = np.asarray(xi, dtype=np.float64)
-        if np.any(~np.isfinite(xi)):
-            raise GeometryError("xi contains NaN or infinite values")
-        eta = self._check_eta(eta)
-        h = self.hand
-        dpsi = TWO_PI * h
-        psi = np.mod(TWO_PI * xi if h > 0 else TWO_PI * (1.0 - xi), TWO_PI)
+        xi, eta, h, dpsi, psi = self._angles(xi, eta)
         cpsi, spsi = np.cos(psi), np.sin(psi)
         # ξ-only: (value, ∂ξ)
         S, S_a = self.section.thickness(psi), self.section.thickness(psi, 1) * dpsi
